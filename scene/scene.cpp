@@ -1,0 +1,108 @@
+#include "scene/scene.h"
+
+#include <cmath>
+
+namespace raypack {
+
+std::uint32_t Scene::add_sphere(const Vec3f& c, float r, std::uint32_t material) {
+    spheres.center.push_back(c);
+    spheres.radius.push_back(std::fabs(r));
+    spheres.inside_only.push_back(r < 0 ? 1 : 0);
+    prims.push_back({PrimKind::Sphere, std::uint32_t(spheres.size() - 1)});
+    prim_material.push_back(material);
+    return std::uint32_t(prims.size() - 1);
+}
+
+std::uint32_t Scene::add_triangle(const Vec3f& a, const Vec3f& b, const Vec3f& c, std::uint32_t material) {
+    triangles.p0.push_back(a);
+    triangles.p1.push_back(b);
+    triangles.p2.push_back(c);
+    triangles.n0.push_back({});
+    triangles.n1.push_back({});
+    triangles.n2.push_back({});
+    triangles.has_normals.push_back(0);
+    prims.push_back({PrimKind::Triangle, std::uint32_t(triangles.size() - 1)});
+    prim_material.push_back(material);
+    return std::uint32_t(prims.size() - 1);
+}
+
+std::uint32_t Scene::add_triangle(const Vec3f& a, const Vec3f& b, const Vec3f& c, const Vec3f& na,
+                                  const Vec3f& nb, const Vec3f& nc, std::uint32_t material) {
+    const std::uint32_t id = add_triangle(a, b, c, material);
+    const std::size_t i = triangles.size() - 1;
+    triangles.n0[i] = na;
+    triangles.n1[i] = nb;
+    triangles.n2[i] = nc;
+    triangles.has_normals[i] = 1;
+    return id;
+}
+
+std::uint32_t Scene::add_cone(const Vec3f& base, float base_r, const Vec3f& apex, float apex_r,
+                              std::uint32_t material) {
+    cones.base.push_back(base);
+    cones.apex.push_back(apex);
+    cones.base_radius.push_back(std::fabs(base_r));
+    cones.apex_radius.push_back(std::fabs(apex_r));
+    cones.inside_only.push_back(base_r < 0 && apex_r < 0 ? 1 : 0);
+    prims.push_back({PrimKind::Cone, std::uint32_t(cones.size() - 1)});
+    prim_material.push_back(material);
+    return std::uint32_t(prims.size() - 1);
+}
+
+void Scene::update_features() {
+    Features f;
+    f.spheres = spheres.size() > 0;
+    f.triangles = triangles.size() > 0;
+    f.cones = cones.size() > 0;
+    for (auto h : triangles.has_normals) f.vertex_normals |= h != 0;
+    for (auto h : spheres.inside_only) f.inside_only |= h != 0;
+    for (auto h : cones.inside_only) f.inside_only |= h != 0;
+    for (std::uint32_t m : prim_material) {
+        f.reflection |= materials[m].ks > 0;
+        f.transmission |= materials[m].transmittance > 0;
+    }
+    for (const auto& l : lights) f.colored_lights |= l.has_color;
+    features = f;
+}
+
+Box3f primitive_bounds(const Scene& s, std::uint32_t prim) {
+    const PrimRef ref = s.prims[prim];
+    Box3f b;
+    const std::uint32_t i = ref.index;
+    switch (ref.kind) {
+        case PrimKind::Sphere: {
+            const float r = s.spheres.radius[i];
+            b.extend(s.spheres.center[i] - Vec3f{r, r, r});
+            b.extend(s.spheres.center[i] + Vec3f{r, r, r});
+            break;
+        }
+        case PrimKind::Triangle:
+            b.extend(s.triangles.p0[i]);
+            b.extend(s.triangles.p1[i]);
+            b.extend(s.triangles.p2[i]);
+            break;
+        case PrimKind::Cone: {
+            // Each end is a disc; its box extent along axis a is r * sqrt(1 - n_a^2).
+            const Vec3f ends[2] = {s.cones.base[i], s.cones.apex[i]};
+            const float radii[2] = {s.cones.base_radius[i], s.cones.apex_radius[i]};
+            const Vec3f axis = normalize(ends[1] - ends[0]);
+            for (int e = 0; e < 2; ++e) {
+                Vec3f ext;
+                for (int a = 0; a < 3; ++a)
+                    ext[a] = radii[e] * std::sqrt(std::max(0.0f, 1.0f - axis[a] * axis[a])) * 1.0001f;  // pad for rounding
+                b.extend(ends[e] - ext);
+                b.extend(ends[e] + ext);
+            }
+            break;
+        }
+    }
+    return b;
+}
+
+Box3f scene_bounds(const Scene& s) {
+    Box3f b;
+    for (std::uint32_t i = 0; i < s.prims.size(); ++i) b.extend(primitive_bounds(s, i));
+    return b;
+}
+
+}  // namespace raypack

@@ -1,0 +1,119 @@
+#pragma once
+// The scene as structure of arrays: one set of arrays per primitive kind,
+// plus a global numbering of primitives in the order the file defines them.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "kernels/aabb.h"
+
+namespace raypack {
+
+enum class PrimKind : std::uint8_t { Sphere, Triangle, Cone };
+
+/// Scene-global primitive number -> kind and index into that kind's arrays.
+struct PrimRef {
+    PrimKind kind;
+    std::uint32_t index;
+};
+
+/// NFF fill: "f red green blue Kd Ks Shine T index_of_refraction".
+struct Material {
+    Vec3f color{1, 1, 1};
+    float kd = 1;
+    float ks = 0;
+    float shine = 0;
+    float transmittance = 0;
+    float ior = 1;
+};
+
+struct PointLight {
+    Vec3f position;
+    Vec3f color{1, 1, 1};
+    bool has_color = false;  ///< NFF lights may omit their colour.
+};
+
+/// NFF viewpoint. fov_deg spans the centres of the top and bottom pixel rows.
+struct Camera {
+    Vec3f from{0, 0, 1};
+    Vec3f at{0, 0, 0};
+    Vec3f up{0, 1, 0};
+    float fov_deg = 45;
+    float hither = 0;
+    int width = 512;
+    int height = 512;
+};
+
+struct SphereSoA {
+    std::vector<Vec3f> center;
+    std::vector<float> radius;      ///< always >= 0
+    std::vector<std::uint8_t> inside_only;  ///< NFF negative radius: only the inside is visible
+    std::size_t size() const { return radius.size(); }
+};
+
+/// Triangles, unindexed: vertex k of triangle i is p[k][i]. Vertex normals are
+/// stored for the triangles that have them (has_normals[i] != 0).
+struct TriangleSoA {
+    std::vector<Vec3f> p0, p1, p2;
+    std::vector<Vec3f> n0, n1, n2;
+    std::vector<std::uint8_t> has_normals;
+    std::size_t size() const { return p0.size(); }
+};
+
+/// NFF cones and cylinders: a truncated cone between base and apex, each end
+/// with its own radius, no end caps.
+struct ConeSoA {
+    std::vector<Vec3f> base, apex;
+    std::vector<float> base_radius, apex_radius;  ///< always >= 0
+    std::vector<std::uint8_t> inside_only;        ///< NFF negative radii
+    std::size_t size() const { return base.size(); }
+};
+
+/// What a scene uses, so that the hot loops can skip what it does not.
+struct Features {
+    bool spheres = false;
+    bool triangles = false;
+    bool cones = false;
+    bool vertex_normals = false;
+    bool reflection = false;    ///< some material has Ks > 0
+    bool transmission = false;  ///< some material has T > 0
+    bool colored_lights = false;
+    bool inside_only = false;   ///< negative radii
+};
+
+struct Scene {
+    std::string source;  ///< file name or gen:NAME:SIZE
+    Camera camera;
+    bool has_camera = false;
+    Vec3f background{0, 0, 0};
+    std::vector<PointLight> lights;
+    std::vector<Material> materials;
+
+    SphereSoA spheres;
+    TriangleSoA triangles;
+    ConeSoA cones;
+
+    std::vector<PrimRef> prims;                ///< global number -> kind, index
+    std::vector<std::uint32_t> prim_material;  ///< global number -> materials[]
+
+    Features features;
+
+    std::size_t primitive_count() const { return prims.size(); }
+
+    // Appending keeps the global numbering in definition order.
+    std::uint32_t add_sphere(const Vec3f& c, float r, std::uint32_t material);
+    std::uint32_t add_triangle(const Vec3f& a, const Vec3f& b, const Vec3f& c, std::uint32_t material);
+    std::uint32_t add_triangle(const Vec3f& a, const Vec3f& b, const Vec3f& c, const Vec3f& na,
+                               const Vec3f& nb, const Vec3f& nc, std::uint32_t material);
+    std::uint32_t add_cone(const Vec3f& base, float base_r, const Vec3f& apex, float apex_r,
+                           std::uint32_t material);
+
+    /// Recomputes `features` from the contents; loaders call it last.
+    void update_features();
+};
+
+/// Bounds of one primitive and of the whole scene.
+Box3f primitive_bounds(const Scene& scene, std::uint32_t prim);
+Box3f scene_bounds(const Scene& scene);
+
+}  // namespace raypack
