@@ -1,0 +1,65 @@
+#pragma once
+// The interface every acceleration structure offers: build from a scene,
+// then closest-hit and any-hit queries on batches of rays. Dispatch is once
+// per batch; inside, each structure runs its own templated loops.
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+
+#include "accel/primitive_intersector.h"
+#include "kernels/ray.h"
+#include "scene/scene.h"
+
+namespace raypack {
+
+struct AccelStats {
+    std::string name;        ///< e.g. "bvh2"
+    std::string builder;     ///< e.g. "binned"
+    double build_ms = 0;
+    std::size_t nodes = 0;
+    std::size_t leaves = 0;
+    std::size_t bytes = 0;   ///< memory of the structure itself
+    int depth = 0;
+    double sah_cost = 0;     ///< SAH cost for trees, 0 where it means nothing
+};
+
+struct AccelConfig {
+    std::string kind = "bvh2";  ///< bvh2 | brute
+    KernelChoice kernels;
+    int max_leaf_size = 4;
+    int sah_bins = 32;
+    float traversal_cost = 1.0f;   ///< SAH cost of visiting a node ...
+    float intersection_cost = 1.0f;  ///< ... relative to one primitive test
+};
+
+class Accel {
+public:
+    virtual ~Accel() = default;
+    /// Closest hit for each ray (hits[i].prim == kNoPrim on a miss).
+    virtual void intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const = 0;
+    /// Any hit in [tnear, tfar]: occluded[i] = 1 if so.
+    virtual void occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const = 0;
+    virtual const AccelStats& stats() const = 0;
+
+    Hitf intersect1(const Rayf& ray) const {
+        Hitf hit;
+        intersect({&ray, 1}, {&hit, 1});
+        return hit;
+    }
+    bool occluded1(const Rayf& ray) const {
+        std::uint8_t o = 0;
+        occluded({&ray, 1}, {&o, 1});
+        return o != 0;
+    }
+};
+
+/// Names accepted by AccelConfig::kind.
+std::span<const char* const> accel_kinds();
+
+/// Builds the structure the config names over every primitive of `scene`.
+/// The scene must outlive the structure. Throws std::invalid_argument for an
+/// unknown kind.
+std::unique_ptr<Accel> build_accel(const Scene& scene, const AccelConfig& config);
+
+}  // namespace raypack

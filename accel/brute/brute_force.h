@@ -1,0 +1,24 @@
+#pragma once
+// The oracle: tests every primitive for every ray. Slow by design and simple
+// enough to trust; every other structure is checked against it.
+#include "accel/accel.h"
+
+namespace raypack {
+
+class BruteForce final : public Accel {
+public:
+    BruteForce(const Scene& scene, KernelChoice kernels);
+    void intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const override;
+    void occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override;
+    const AccelStats& stats() const override { return stats_; }
+
+    /// The same search in double precision, for reference answers.
+    Hit<double> intersect_double(const Ray<double>& ray) const;
+
+private:
+    const Scene* scene_;
+    KernelChoice kernels_;
+    AccelStats stats_;
+};
+
+}  // namespace raypack

@@ -1,0 +1,98 @@
+#include "accel/bvh/bvh2_accel.h"
+
+#include <chrono>
+#include <vector>
+
+namespace raypack {
+
+Bvh2Accel::Bvh2Accel(const Scene& scene, const AccelConfig& config) : scene_(&scene), kernels_(config.kernels) {
+    const auto start = std::chrono::steady_clock::now();
+    const std::size_t n = scene.primitive_count();
+    std::vector<Box3f> boxes(n);
+    std::vector<Vec3f> centers(n);
+    for (std::uint32_t i = 0; i < n; ++i) {
+        boxes[i] = primitive_bounds(scene, i);
+        centers[i] = boxes[i].center();
+    }
+    BinnedSahConfig bc;
+    bc.bins = config.sah_bins;
+    bc.max_leaf_size = config.max_leaf_size;
+    bc.traversal_cost = config.traversal_cost;
+    bc.intersection_cost = config.intersection_cost;
+    bvh_ = build_binned_sah(boxes, centers, bc);
+    const auto stop = std::chrono::steady_clock::now();
+    stats_.name = "bvh2";
+    stats_.builder = "binned";
+    stats_.build_ms = std::chrono::duration<double, std::milli>(stop - start).count();
+    stats_.nodes = bvh_.nodes.size();
+    stats_.leaves = bvh_.leaves;
+    stats_.depth = bvh_.depth;
+    stats_.bytes = bvh_.nodes.size() * sizeof(Bvh2Node) + bvh_.prim_index.size() * sizeof(std::uint32_t);
+    stats_.sah_cost = sah_cost(bvh_, bc.traversal_cost, bc.intersection_cost);
+}
+
+// Depth-first traversal, nearer child first, with an explicit stack.
+template <bool AnyHit>
+bool Bvh2Accel::trace(Rayf& ray, Hitf& hit) const {
+    if (bvh_.nodes.empty()) return false;
+    const PrimitiveIntersector<float> isect{scene_, kernels_};
+    const Vec3f inv_dir = reciprocal(ray.dir);
+    const Bvh2Node* nodes = bvh_.nodes.data();
+    float entry;
+    if (!intersect_aabb(ray.org, inv_dir, nodes[0].box, ray.tnear, ray.tfar, entry)) return false;
+    std::uint32_t stack[kBvhMaxDepth + 1];
+    int sp = 0;
+    std::uint32_t current = 0;
+    bool found = false;
+    for (;;) {
+        const Bvh2Node& node = nodes[current];
+        if (node.is_leaf()) {
+            for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
+                if (isect.intersect(bvh_.prim_index[k], ray, hit)) {
+                    found = true;
+                    if constexpr (AnyHit) return true;
+                }
+            }
+        } else {
+            const std::uint32_t left = current + 1, right = node.first;
+            float t_left, t_right;
+            const bool hit_left = intersect_aabb(ray.org, inv_dir, nodes[left].box, ray.tnear, ray.tfar, t_left);
+            const bool hit_right = intersect_aabb(ray.org, inv_dir, nodes[right].box, ray.tnear, ray.tfar, t_right);
+            if (hit_left && hit_right) {
+                const bool left_first = t_left <= t_right;
+                stack[sp++] = left_first ? right : left;
+                current = left_first ? left : right;
+                continue;
+            }
+            if (hit_left || hit_right) {
+                current = hit_left ? left : right;
+                continue;
+            }
+        }
+        // Pop, skipping nodes the ray can no longer reach before its closest hit.
+        for (;;) {
+            if (sp == 0) return found;
+            current = stack[--sp];
+            if (intersect_aabb(ray.org, inv_dir, nodes[current].box, ray.tnear, ray.tfar, entry)) break;
+        }
+    }
+}
+
+void Bvh2Accel::intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const {
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        Rayf ray = rays[i];
+        Hitf hit;
+        trace<false>(ray, hit);
+        hits[i] = hit;
+    }
+}
+
+void Bvh2Accel::occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const {
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        Rayf ray = rays[i];
+        Hitf hit;
+        occluded[i] = trace<true>(ray, hit) ? 1 : 0;
+    }
+}
+
+}  // namespace raypack

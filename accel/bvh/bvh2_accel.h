@@ -1,0 +1,26 @@
+#pragma once
+// Scalar traversal of a BVH2, the reference path for every faster BVH.
+#include "accel/accel.h"
+#include "accel/bvh/binned_sah_builder.h"
+
+namespace raypack {
+
+class Bvh2Accel final : public Accel {
+public:
+    Bvh2Accel(const Scene& scene, const AccelConfig& config);
+    void intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const override;
+    void occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override;
+    const AccelStats& stats() const override { return stats_; }
+    const Bvh2& bvh() const { return bvh_; }
+
+private:
+    template <bool AnyHit>
+    bool trace(Rayf& ray, Hitf& hit) const;
+
+    const Scene* scene_;
+    KernelChoice kernels_;
+    Bvh2 bvh_;
+    AccelStats stats_;
+};
+
+}  // namespace raypack

@@ -1,0 +1,54 @@
+// raypack: the command line. Each subcommand lives in its own file.
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <string>
+
+#include "app/commands.h"
+
+namespace {
+
+void print_usage(std::FILE* out) {
+    std::fputs(
+        "usage: raypack COMMAND [options]\n"
+        "\n"
+        "commands:\n"
+        "  render SCENE [-o out.png] [--res W H] [--depth D] [--threads T]\n"
+        "  trace  SCENE --rays FILE.rays [-o FILE.hits] [--threads T] [--repeat R] [--json]\n"
+        "  info   SCENE\n"
+        "  gen    NAME --size S -o FILE.nff\n"
+        "\n"
+        "SCENE is an .nff or .obj file, or gen:NAME:SIZE for a generated SPD scene.\n"
+        "Run 'raypack COMMAND --help' for a command's options.\n",
+        out);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    if (argc < 2) {
+        print_usage(stderr);
+        return 2;
+    }
+    const std::string command = argv[1];
+    if (command == "-h" || command == "--help" || command == "help") {
+        print_usage(stdout);
+        return 0;
+    }
+    const raypack::app::Args args(argc - 2, argv + 2);
+    try {
+        if (command == "render") return raypack::app::run_render(args);
+        if (command == "trace") return raypack::app::run_trace(args);
+        if (command == "info") return raypack::app::run_info(args);
+        if (command == "gen") return raypack::app::run_gen(args);
+    } catch (const raypack::app::UsageError& e) {
+        std::fprintf(stderr, "raypack %s: %s\n", command.c_str(), e.what());
+        return 2;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "raypack %s: error: %s\n", command.c_str(), e.what());
+        return 1;
+    }
+    std::fprintf(stderr, "raypack: unknown command '%s'\n\n", command.c_str());
+    print_usage(stderr);
+    return 2;
+}

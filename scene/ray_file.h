@@ -1,0 +1,30 @@
+#pragma once
+// The .rays / .hits exchange format (docs/rays.md): the same rays traced by
+// raypack and by any other tracer, compared ray by ray.
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "kernels/ray.h"
+
+namespace raypack {
+
+enum class RayKind : std::uint32_t { ClosestHit = 0, AnyHit = 1 };
+
+struct RayFile {
+    RayKind kind = RayKind::ClosestHit;
+    std::vector<Rayf> rays;
+};
+
+/// Throws std::runtime_error naming the file and the problem (bad magic,
+/// truncated, unknown kind, non-finite origin or direction, absurd count).
+RayFile read_rays(const std::string& path);
+std::vector<Hitf> read_hits(const std::string& path);
+
+/// Both write to a temporary file beside `path` and rename it into place, so
+/// an existing file is never left half-written.
+void write_rays(const std::string& path, RayKind kind, std::span<const Rayf> rays);
+void write_hits(const std::string& path, std::span<const Hitf> hits);
+
+}  // namespace raypack
