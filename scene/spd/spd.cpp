@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "scene/spd/generators.h"
+
 namespace raypack {
 
 namespace {
@@ -13,13 +15,16 @@ struct Entry {
     const char* name;
     int default_size;
     int max_size;
+    std::string (*generate)(int size);
 };
 
-// Sizes as in SPD 3.14: default size factor and the largest the program accepts.
+// Default size factors as in SPD 3.14. SPD itself has no upper bound; ours
+// keep the output within a few million primitives, and mount stops at 7
+// because its original hash shifts by (7 - size) bits.
 constexpr Entry kGenerators[] = {
-    {"balls", 4, 5},
-    {"tetra", 6, 10},
-    {"mount", 6, 8},
+    {"balls", 4, 6, spd::generate_balls},
+    {"tetra", 6, 9, spd::generate_tetra},
+    {"mount", 6, 7, spd::generate_mount},
 };
 
 std::string valid_names() {
@@ -45,7 +50,7 @@ std::string generate_spd(std::string_view name, int size) {
         if (size < 1 || size > e.max_size)
             throw std::invalid_argument("generate_spd: size " + std::to_string(size) + " out of range 1.." +
                                         std::to_string(e.max_size) + " for '" + std::string(name) + "'");
-        throw std::invalid_argument("generate_spd: generator '" + std::string(name) + "' not implemented yet");
+        return e.generate(size);
     }
     throw std::invalid_argument("generate_spd: unknown SPD generator '" + std::string(name) +
                                 "' (valid: " + valid_names() + ")");

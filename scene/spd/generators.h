@@ -1,0 +1,13 @@
+#pragma once
+// The individual SPD generators behind generate_spd() (scene/spd/spd.h).
+// Each returns the NFF text of its scene at the given size factor; the size
+// has already been range-checked by the caller.
+#include <string>
+
+namespace raypack::spd {
+
+std::string generate_balls(int size);
+std::string generate_tetra(int size);
+std::string generate_mount(int size);
+
+}  // namespace raypack::spd

@@ -1,0 +1,142 @@
+// The SPD generators against the reference NFF files in scenes/, which are
+// the unmodified output of Eric Haines' SPD 3.14 programs.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cstddef>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "scene/spd/spd.h"
+
+namespace {
+
+std::string read_text(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw std::runtime_error("cannot open " + path);
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+std::vector<std::string> split_lines(const std::string& text) {
+    std::vector<std::string> lines;
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);) lines.push_back(line);
+    return lines;
+}
+
+std::string reference_path(const std::string& name) {
+    return std::string(RAYPACK_SOURCE_DIR) + "/scenes/" + name + ".nff";
+}
+
+/// Compares line by line and reports the first differing lines (at most a
+/// few) with their line numbers, then the whole-text equality.
+void expect_matches_reference(const std::string& name, int size) {
+    const std::string generated = raypack::generate_spd(name, size);
+    const std::string reference = read_text(reference_path(name));
+    const std::vector<std::string> got = split_lines(generated);
+    const std::vector<std::string> want = split_lines(reference);
+
+    int reported = 0;
+    const std::size_t common = std::min(got.size(), want.size());
+    for (std::size_t i = 0; i < common && reported < 5; ++i) {
+        if (got[i] != want[i]) {
+            ADD_FAILURE() << name << " line " << (i + 1) << " differs:\n  generated: " << got[i]
+                          << "\n  reference: " << want[i];
+            ++reported;
+        }
+    }
+    EXPECT_EQ(got.size(), want.size()) << name << ": line counts differ";
+    EXPECT_TRUE(generated == reference) << name << ": text is not byte-identical";
+}
+
+/// Number of statements per NFF keyword (first token of non-vertex lines).
+std::map<std::string, int> count_keywords(const std::string& text) {
+    std::map<std::string, int> counts;
+    for (const std::string& line : split_lines(text)) {
+        std::istringstream in(line);
+        std::string word;
+        in >> word;
+        if (!word.empty() && (std::isalpha(static_cast<unsigned char>(word[0])) != 0)) ++counts[word];
+    }
+    return counts;
+}
+
+int power(int base, int exp) {
+    int r = 1;
+    for (int i = 0; i < exp; ++i) r *= base;
+    return r;
+}
+
+}  // namespace
+
+TEST(SpdGenerators, BallsMatchesReference) { expect_matches_reference("balls", 4); }
+TEST(SpdGenerators, TetraMatchesReference) { expect_matches_reference("tetra", 6); }
+TEST(SpdGenerators, MountMatchesReference) { expect_matches_reference("mount", 6); }
+
+TEST(SpdGenerators, BallsCountsFollowFormula) {
+    // Every sphere has nine children down to depth SIZE: sum of 9^k, k = 0..SIZE.
+    for (int size = 1; size <= 3; ++size) {
+        int spheres = 0;
+        for (int k = 0; k <= size; ++k) spheres += power(9, k);
+        auto counts = count_keywords(raypack::generate_spd("balls", size));
+        EXPECT_EQ(counts["s"], spheres) << "size " << size;
+        EXPECT_EQ(counts["p"], 1) << "size " << size;
+        EXPECT_EQ(counts["l"], 3) << "size " << size;
+    }
+    EXPECT_EQ(count_keywords(raypack::generate_spd("balls", 1))["s"], 10);
+}
+
+TEST(SpdGenerators, TetraCountsFollowFormula) {
+    // 4^SIZE triangles: four sub-tetrahedra per level, four faces at the bottom.
+    for (int size = 1; size <= 4; ++size) {
+        auto counts = count_keywords(raypack::generate_spd("tetra", size));
+        EXPECT_EQ(counts["p"], power(4, size)) << "size " << size;
+        EXPECT_EQ(counts["s"], 0) << "size " << size;
+    }
+}
+
+TEST(SpdGenerators, MountCountsFollowFormula) {
+    // 2 * 4^SIZE triangles (a 2^SIZE square grid) plus the four glass spheres.
+    for (int size = 1; size <= 4; ++size) {
+        auto counts = count_keywords(raypack::generate_spd("mount", size));
+        EXPECT_EQ(counts["p"], 2 * power(4, size)) << "size " << size;
+        EXPECT_EQ(counts["s"], 4) << "size " << size;
+    }
+}
+
+TEST(SpdGenerators, ListsGeneratorsWithDefaults) {
+    const auto gens = raypack::spd_generators();
+    std::map<std::string, int> defaults;
+    for (const auto& g : gens) {
+        defaults[g.name] = g.default_size;
+        EXPECT_GE(g.max_size, g.default_size) << g.name;
+    }
+    EXPECT_EQ(defaults["balls"], 4);
+    EXPECT_EQ(defaults["tetra"], 6);
+    EXPECT_EQ(defaults["mount"], 6);
+}
+
+TEST(SpdGenerators, RejectsUnknownNamesAndBadSizes) {
+    EXPECT_THROW(raypack::generate_spd("nosuch", 1), std::invalid_argument);
+    EXPECT_THROW(raypack::generate_spd("", 1), std::invalid_argument);
+    EXPECT_THROW(raypack::generate_spd("BALLS", 1), std::invalid_argument);
+    for (const auto& g : raypack::spd_generators()) {
+        EXPECT_THROW(raypack::generate_spd(g.name, 0), std::invalid_argument) << g.name;
+        EXPECT_THROW(raypack::generate_spd(g.name, -1), std::invalid_argument) << g.name;
+        EXPECT_THROW(raypack::generate_spd(g.name, g.max_size + 1), std::invalid_argument) << g.name;
+    }
+    try {
+        raypack::generate_spd("nosuch", 1);
+    } catch (const std::invalid_argument& e) {
+        // The message names the valid generators.
+        EXPECT_NE(std::string(e.what()).find("balls"), std::string::npos);
+        EXPECT_NE(std::string(e.what()).find("mount"), std::string::npos);
+    }
+}
