@@ -79,6 +79,8 @@ int power(int base, int exp) {
 TEST(SpdGenerators, BallsMatchesReference) { expect_matches_reference("balls", 4); }
 TEST(SpdGenerators, TetraMatchesReference) { expect_matches_reference("tetra", 6); }
 TEST(SpdGenerators, MountMatchesReference) { expect_matches_reference("mount", 6); }
+TEST(SpdGenerators, RingsMatchesReference) { expect_matches_reference("rings", 7); }
+TEST(SpdGenerators, TreeMatchesReference) { expect_matches_reference("tree", 11); }
 
 TEST(SpdGenerators, BallsCountsFollowFormula) {
     // Every sphere has nine children down to depth SIZE: sum of 9^k, k = 0..SIZE.
@@ -111,6 +113,30 @@ TEST(SpdGenerators, MountCountsFollowFormula) {
     }
 }
 
+TEST(SpdGenerators, RingsCountsFollowFormula) {
+    // Layer k (1-based) holds k*k objects of 30 cylinders and 30 spheres:
+    // 30 * sum k^2 = 5 * SIZE * (SIZE+1) * (2*SIZE+1), plus the wall.
+    for (int size = 1; size <= 3; ++size) {
+        auto counts = count_keywords(raypack::generate_spd("rings", size));
+        const int expected = 5 * size * (size + 1) * (2 * size + 1);
+        EXPECT_EQ(counts["s"], expected) << "size " << size;
+        EXPECT_EQ(counts["c"], expected) << "size " << size;
+        EXPECT_EQ(counts["p"], 1) << "size " << size;
+    }
+}
+
+TEST(SpdGenerators, TreeCountsFollowFormula) {
+    // A full binary tree of depth SIZE: 2^(SIZE+1) - 1 branches, each a cone
+    // and a sphere, plus the field.
+    for (int size = 1; size <= 4; ++size) {
+        auto counts = count_keywords(raypack::generate_spd("tree", size));
+        EXPECT_EQ(counts["c"], power(2, size + 1) - 1) << "size " << size;
+        EXPECT_EQ(counts["s"], power(2, size + 1) - 1) << "size " << size;
+        EXPECT_EQ(counts["p"], 1) << "size " << size;
+        EXPECT_EQ(counts["l"], 7) << "size " << size;
+    }
+}
+
 TEST(SpdGenerators, ListsGeneratorsWithDefaults) {
     const auto gens = raypack::spd_generators();
     std::map<std::string, int> defaults;
@@ -121,6 +147,8 @@ TEST(SpdGenerators, ListsGeneratorsWithDefaults) {
     EXPECT_EQ(defaults["balls"], 4);
     EXPECT_EQ(defaults["tetra"], 6);
     EXPECT_EQ(defaults["mount"], 6);
+    EXPECT_EQ(defaults["rings"], 7);
+    EXPECT_EQ(defaults["tree"], 11);
 }
 
 TEST(SpdGenerators, RejectsUnknownNamesAndBadSizes) {

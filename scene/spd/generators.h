@@ -9,5 +9,7 @@ namespace raypack::spd {
 std::string generate_balls(int size);
 std::string generate_tetra(int size);
 std::string generate_mount(int size);
+std::string generate_rings(int size);
+std::string generate_tree(int size);
 
 }  // namespace raypack::spd

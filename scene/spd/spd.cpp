@@ -25,6 +25,8 @@ constexpr Entry kGenerators[] = {
     {"balls", 4, 6, spd::generate_balls},
     {"tetra", 6, 9, spd::generate_tetra},
     {"mount", 6, 7, spd::generate_mount},
+    {"rings", 7, 20, spd::generate_rings},
+    {"tree", 11, 18, spd::generate_tree},
 };
 
 std::string valid_names() {
