@@ -1,0 +1,46 @@
+#include "app/accel_options.h"
+
+#include <tbb/global_control.h>
+#include <tbb/info.h>
+
+namespace raypack::app {
+
+std::vector<OptionSpec> accel_option_specs() {
+    return {{"--accel", "", 1}, {"--sphere", "", 1}, {"--triangle", "", 1}};
+}
+
+std::string accel_options_help() {
+    return "  --accel bvh2|brute            acceleration structure (default bvh2)\n"
+           "  --sphere geometric|algebraic  ray-sphere test (default geometric)\n"
+           "  --triangle moeller|plane      ray-triangle test (default moeller)\n";
+}
+
+AccelConfig accel_config_from(const ParsedArgs& args) {
+    AccelConfig config;
+    config.kind = args.text("--accel", "bvh2");
+    bool known = false;
+    for (const char* k : accel_kinds()) known |= config.kind == k;
+    if (!known) throw UsageError("--accel: unknown structure '" + config.kind + "' (expected bvh2 or brute)");
+    const std::string sphere = args.text("--sphere", "geometric");
+    if (sphere == "geometric") config.kernels.sphere = SphereMethod::Geometric;
+    else if (sphere == "algebraic") config.kernels.sphere = SphereMethod::Algebraic;
+    else throw UsageError("--sphere: expected geometric or algebraic, got '" + sphere + "'");
+    const std::string tri = args.text("--triangle", "moeller");
+    if (tri == "moeller") config.kernels.triangle = TriangleMethod::Moeller;
+    else if (tri == "plane") config.kernels.triangle = TriangleMethod::Plane;
+    else throw UsageError("--triangle: expected moeller or plane, got '" + tri + "'");
+    return config;
+}
+
+struct ThreadLimit::Impl {
+    tbb::global_control control;
+};
+
+ThreadLimit::ThreadLimit(int threads)
+    : impl_(nullptr), threads_(threads > 0 ? threads : tbb::info::default_concurrency()) {
+    if (threads > 0) impl_ = new Impl{tbb::global_control(tbb::global_control::max_allowed_parallelism, std::size_t(threads))};
+}
+
+ThreadLimit::~ThreadLimit() { delete impl_; }
+
+}  // namespace raypack::app

@@ -1,0 +1,30 @@
+#pragma once
+// Options shared by render and trace that choose the structure and kernels.
+#include <vector>
+
+#include "accel/accel.h"
+#include "app/commands.h"
+
+namespace raypack::app {
+
+/// --accel, --sphere, --triangle
+std::vector<OptionSpec> accel_option_specs();
+AccelConfig accel_config_from(const ParsedArgs& args);
+std::string accel_options_help();
+
+/// --threads T: limits oneTBB for the life of the returned object.
+class ThreadLimit {
+public:
+    explicit ThreadLimit(int threads);
+    ~ThreadLimit();
+    ThreadLimit(const ThreadLimit&) = delete;
+    ThreadLimit& operator=(const ThreadLimit&) = delete;
+    int threads() const { return threads_; }
+
+private:
+    struct Impl;
+    Impl* impl_;
+    int threads_;
+};
+
+}  // namespace raypack::app

@@ -1,0 +1,84 @@
+// raypack render SCENE [-o out.png] [--res W H] [--depth D] [--threads T]
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+
+#include "app/accel_options.h"
+#include "app/commands.h"
+#include "render/whitted.h"
+#include "scene/load.h"
+
+namespace raypack::app {
+namespace {
+
+double ms_since(std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+}
+
+std::string default_output(const std::string& spec) {
+    if (spec.rfind("gen:", 0) == 0) {
+        std::string name = spec.substr(4);
+        for (char& c : name)
+            if (c == ':') c = '-';
+        return name + ".png";
+    }
+    return std::filesystem::path(spec).stem().string() + ".png";
+}
+
+}  // namespace
+
+int run_render(const Args& args) {
+    auto spec = accel_option_specs();
+    spec.insert(spec.end(), {{"--output", "-o", 1}, {"--res", "", 2}, {"--depth", "", 1}, {"--threads", "", 1}});
+    const ParsedArgs p(args, spec, 1);
+    if (p.help() || p.positional().empty()) {
+        std::printf(
+            "usage: raypack render SCENE [-o out.png] [--res W H] [--depth D] [--threads T]\n"
+            "  -o FILE       output image; format from the extension (png, exr, ...)\n"
+            "  --res W H     resolution (default: the scene's, 512x512 for SPD)\n"
+            "  --depth D     maximum ray depth, eye ray = 1 (default 5, the SPD protocol)\n"
+            "  --threads T   worker threads (default: all cores)\n%s",
+            accel_options_help().c_str());
+        if (!p.help()) throw UsageError("missing SCENE");
+        return 0;
+    }
+    const std::string scene_spec = p.positional()[0];
+    const AccelConfig config = accel_config_from(p);
+    WhittedOptions options;
+    options.max_depth = int(p.integer("--depth", 5, 1, 64));
+    const ThreadLimit limit(int(p.integer("--threads", 0, 1, 1024)));
+    const std::string output = p.has("--output") ? p.text("--output") : default_output(scene_spec);
+
+    auto t0 = std::chrono::steady_clock::now();
+    const Scene scene = load_scene(scene_spec);
+    const double load_ms = ms_since(t0);
+    options.width = int(p.integer("--res", scene.camera.width, 1, 65536, 0));
+    options.height = int(p.integer("--res", scene.camera.height, 1, 65536, 1));
+    if (std::uint64_t(options.width) * std::uint64_t(options.height) > (1ull << 28))
+        throw UsageError("--res: image of more than 2^28 pixels");
+
+    const auto accel = build_accel(scene, config);
+    Image image;
+    const RenderStats stats = render_whitted(scene, *accel, options, image);
+    t0 = std::chrono::steady_clock::now();
+    write_image(output, image);
+    const double write_ms = ms_since(t0);
+
+    const AccelStats& as = accel->stats();
+    std::printf("raypack render: %s\n", scene.source.c_str());
+    std::printf("  scene      %zu primitives (%zu spheres, %zu triangles, %zu cones), %zu lights, loaded in %.1f ms\n",
+                scene.primitive_count(), scene.spheres.size(), scene.triangles.size(), scene.cones.size(),
+                scene.lights.size(), load_ms);
+    std::printf("  structure  %s (%s), %zu nodes, SAH cost %.2f, built in %.1f ms\n", as.name.c_str(),
+                as.builder.c_str(), as.nodes, as.sah_cost, as.build_ms);
+    std::printf("  render     %dx%d, depth %d, %d threads, Whitted: %.1f ms\n", options.width, options.height,
+                options.max_depth, limit.threads(), stats.render_ms);
+    std::printf("  rays       eye %llu (%llu hit), reflect %llu, refract %llu, shadow %llu\n",
+                (unsigned long long)stats.eye_rays, (unsigned long long)stats.eye_hits,
+                (unsigned long long)stats.reflect_rays, (unsigned long long)stats.refract_rays,
+                (unsigned long long)stats.shadow_rays);
+    std::printf("  image      %s (written in %.1f ms)\n", std::filesystem::absolute(output).string().c_str(), write_ms);
+    return 0;
+}
+
+}  // namespace raypack::app

@@ -1,0 +1,36 @@
+#pragma once
+// A linear RGB float image and its output through OpenImageIO.
+#include <string>
+#include <vector>
+
+#include "kernels/vec3.h"
+
+namespace raypack {
+
+struct Image {
+    int width = 0, height = 0;
+    std::vector<float> rgb;  ///< row-major from the top row, 3 floats per pixel
+
+    Image() = default;
+    Image(int w, int h) : width(w), height(h), rgb(std::size_t(w) * std::size_t(h) * 3, 0.0f) {}
+    Vec3f at(int x, int y) const {
+        const float* p = &rgb[(std::size_t(y) * std::size_t(width) + std::size_t(x)) * 3];
+        return {p[0], p[1], p[2]};
+    }
+    void set(int x, int y, const Vec3f& c) {
+        float* p = &rgb[(std::size_t(y) * std::size_t(width) + std::size_t(x)) * 3];
+        p[0] = c.x;
+        p[1] = c.y;
+        p[2] = c.z;
+    }
+};
+
+/// Writes the image in the format its extension names (.png, .exr, .tif,
+/// .jpg, .ppm, ...), 8-bit formats clamped to [0, 1]. Written to a temporary
+/// file and renamed. Throws std::runtime_error naming the file on failure.
+void write_image(const std::string& path, const Image& image);
+
+/// Reads any image OpenImageIO reads, as linear RGB floats (for tests and tools).
+Image read_image(const std::string& path);
+
+}  // namespace raypack

@@ -1,0 +1,154 @@
+#include "render/whitted.h"
+
+#include <tbb/blocked_range2d.h>
+#include <tbb/parallel_for.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+
+#include "render/camera_rays.h"
+#include "render/surface.h"
+
+namespace raypack {
+namespace {
+
+float max_abs(const Vec3f& v) { return std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}); }
+
+class WhittedTracer {
+public:
+    WhittedTracer(const Scene& scene, const Accel& accel, const WhittedOptions& options)
+        : scene_(scene), accel_(accel), options_(options) {
+        // SPD Readme: each light and the ambient term get sqrt(L) / (2 L).
+        const float n = float(std::max<std::size_t>(scene.lights.size(), 1));
+        intensity_ = std::sqrt(n) / (2.0f * n);
+        const Box3f b = scene_bounds(scene);
+        scene_extent_ = b.empty() ? 1.0f : std::max(length(b.extent()), 1e-30f);
+    }
+
+    Vec3f trace(const Rayf& ray, int depth, RenderStats& stats) const {
+        const Hitf hit = accel_.intersect1(ray);
+        if (depth == 1) {
+            ++stats.eye_rays;
+            stats.eye_hits += hit.found();
+        }
+        if (!hit.found()) return scene_.background;
+        return shade(ray, hit, depth, stats);
+    }
+
+private:
+    const Scene& scene_;
+    const Accel& accel_;
+    const WhittedOptions& options_;
+    float intensity_ = 1;
+    float scene_extent_ = 1;
+
+    float offset_at(const Vec3f& p) const {
+        return options_.offset_scale * std::max(max_abs(p), 1e-3f * scene_extent_);
+    }
+
+    Vec3f shade(const Rayf& ray, const Hitf& hit, int depth, RenderStats& stats) const {
+        const Surface s = surface_at(scene_, ray, hit);
+        const Material& m = scene_.materials[s.material];
+        const Vec3f view = normalize(ray.dir);
+        // Shade the side the ray arrives on: both normals face the viewer.
+        const bool front = dot(view, s.geometric_normal) < 0;
+        const Vec3f ng = front ? s.geometric_normal : -s.geometric_normal;
+        Vec3f ns = front ? s.shading_normal : -s.shading_normal;
+        if (dot(ns, ng) < 0) ns = ng;  // interpolated normal bent past the surface
+        const float eps = offset_at(s.point);
+        const Vec3f above = s.point + ng * eps;
+
+        Vec3f color = m.color * (intensity_ * m.kd);  // ambient
+        for (const PointLight& light : scene_.lights) {
+            const Vec3f to_light = light.position - above;
+            const float dist = length(to_light);
+            const Vec3f l = to_light / dist;
+            // SPD protocol: no shadow ray when the surface faces away from the light.
+            if (dot(ns, l) <= 0 || dot(ng, l) <= 0) continue;
+            ++stats.shadow_rays;
+            Rayf shadow;
+            shadow.org = above;
+            shadow.dir = to_light;
+            shadow.tnear = 0;
+            shadow.tfar = 1.0f - 1e-6f;
+            if (accel_.occluded1(shadow)) continue;
+            const float atten =
+                1.0f / (options_.atten_c2 * dist * dist + options_.atten_c1 * dist + options_.atten_c0);
+            const Vec3f light_color = light.color * (intensity_ * atten);
+            const float diffuse = m.kd * dot(ns, l);
+            const Vec3f r = ns * (2.0f * dot(ns, l)) - l;  // mirror of l about the normal
+            const float rv = std::max(0.0f, -dot(r, view));
+            const float specular = m.ks > 0 && rv > 0 ? m.ks * std::pow(rv, m.shine) : 0.0f;
+            color += light_color * m.color * diffuse + light_color * specular;
+        }
+        if (depth >= options_.max_depth) return color;
+
+        const Vec3f reflected_dir = view - ns * (2.0f * dot(view, ns));
+        if (m.ks > 0) {
+            ++stats.reflect_rays;
+            color += trace(secondary(above, reflected_dir), depth + 1, stats) * m.ks;
+        }
+        if (m.transmittance > 0) {
+            // Snell's law; entering when the ray meets the outward side.
+            const float eta = front ? 1.0f / m.ior : m.ior;
+            const float cos_i = -dot(view, ns);
+            const float k = 1.0f - eta * eta * (1.0f - cos_i * cos_i);
+            if (k >= 0) {
+                ++stats.refract_rays;
+                const Vec3f dir = view * eta + ns * (eta * cos_i - std::sqrt(k));
+                color += trace(secondary(s.point - ng * eps, dir), depth + 1, stats) * m.transmittance;
+            } else {
+                // Total internal reflection: the transmitted share is reflected.
+                ++stats.reflect_rays;
+                color += trace(secondary(above, reflected_dir), depth + 1, stats) * m.transmittance;
+            }
+        }
+        return color;
+    }
+
+    static Rayf secondary(const Vec3f& org, const Vec3f& dir) {
+        Rayf r;
+        r.org = org;
+        r.dir = dir;
+        r.tnear = 0;
+        return r;
+    }
+};
+
+void add(std::atomic<std::uint64_t>& a, std::uint64_t v) { a.fetch_add(v, std::memory_order_relaxed); }
+
+}  // namespace
+
+RenderStats render_whitted(const Scene& scene, const Accel& accel, const WhittedOptions& options, Image& image) {
+    const auto start = std::chrono::steady_clock::now();
+    image = Image(options.width, options.height);
+    const CameraFrame frame = make_camera_frame(scene.camera, options.width, options.height);
+    const WhittedTracer tracer(scene, accel, options);
+    std::atomic<std::uint64_t> eye{0}, eye_hits{0}, reflect{0}, refract{0}, shadow{0};
+    const int tile = std::max(options.tile_size, 1);
+    tbb::parallel_for(tbb::blocked_range2d<int>(0, options.height, tile, 0, options.width, tile),
+                      [&](const tbb::blocked_range2d<int>& r) {
+                          RenderStats local;
+                          for (int y = r.rows().begin(); y < r.rows().end(); ++y)
+                              for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
+                                  const Rayf ray = camera_ray(frame, float(x) + 0.5f, float(y) + 0.5f);
+                                  image.set(x, y, tracer.trace(ray, 1, local));
+                              }
+                          add(eye, local.eye_rays);
+                          add(eye_hits, local.eye_hits);
+                          add(reflect, local.reflect_rays);
+                          add(refract, local.refract_rays);
+                          add(shadow, local.shadow_rays);
+                      });
+    RenderStats stats;
+    stats.eye_rays = eye;
+    stats.eye_hits = eye_hits;
+    stats.reflect_rays = reflect;
+    stats.refract_rays = refract;
+    stats.shadow_rays = shadow;
+    stats.render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return stats;
+}
+
+}  // namespace raypack

@@ -1,0 +1,38 @@
+#pragma once
+// Whitted-style recursive ray tracing (Whitted, "An Improved Illumination
+// Model for Shaded Display", CACM 1980) with NFF's shading parameters.
+#include <cstdint>
+
+#include "accel/accel.h"
+#include "render/image.h"
+#include "scene/scene.h"
+
+namespace raypack {
+
+struct WhittedOptions {
+    int width = 512;
+    int height = 512;
+    int max_depth = 5;  ///< the eye ray has depth 1 (SPD protocol: 5)
+    /// Distance attenuation 1 / (c2 r^2 + c1 r + c0) per light; NFF has none.
+    float atten_c0 = 1, atten_c1 = 0, atten_c2 = 0;
+    /// Secondary-ray origins move this far along the normal, relative to the
+    /// larger of the hit point's magnitude and 1e-3 of the scene's extent.
+    float offset_scale = 1e-4f;
+    int tile_size = 16;
+};
+
+/// Ray counts in the SPD Readme's terms, to compare with its statistics table.
+struct RenderStats {
+    std::uint64_t eye_rays = 0;
+    std::uint64_t eye_hits = 0;
+    std::uint64_t reflect_rays = 0;
+    std::uint64_t refract_rays = 0;
+    std::uint64_t shadow_rays = 0;
+    double render_ms = 0;
+};
+
+/// Renders one sample per pixel centre, tiles in parallel with oneTBB (the
+/// caller limits threads with tbb::global_control).
+RenderStats render_whitted(const Scene& scene, const Accel& accel, const WhittedOptions& options, Image& image);
+
+}  // namespace raypack
