@@ -45,5 +45,6 @@ int run_render(const Args& args);
 int run_trace(const Args& args);
 int run_info(const Args& args);
 int run_gen(const Args& args);
+int run_rays(const Args& args);
 
 }  // namespace raypack::app

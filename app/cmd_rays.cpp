@@ -1,0 +1,43 @@
+// raypack rays SCENE --kind camera|shadow [--res W H] -o FILE.rays
+// Writes the ray sets the benchmarks and the Embree comparison trace.
+#include <cstdio>
+
+#include "app/commands.h"
+#include "render/camera_rays.h"
+#include "render/ray_sets.h"
+#include "scene/load.h"
+#include "scene/ray_file.h"
+
+namespace raypack::app {
+
+int run_rays(const Args& args) {
+    const ParsedArgs p(args, {{"--kind", "", 1}, {"--res", "", 2}, {"--output", "-o", 1}}, 1);
+    if (p.help() || p.positional().empty()) {
+        std::printf(
+            "usage: raypack rays SCENE --kind camera|shadow [--res W H] -o FILE.rays\n"
+            "  camera   one closest-hit ray through each pixel centre (kind 0)\n"
+            "  shadow   any-hit rays from each camera hit to the first light (kind 1)\n");
+        if (!p.help()) throw UsageError("missing SCENE");
+        return 0;
+    }
+    if (!p.has("--output")) throw UsageError("missing -o FILE.rays");
+    const std::string kind = p.text("--kind", "camera");
+    const Scene scene = load_scene(p.positional()[0]);
+    const int w = int(p.integer("--res", scene.camera.width, 1, 16384, 0));
+    const int h = int(p.integer("--res", scene.camera.height, 1, 16384, 1));
+    std::vector<Rayf> rays;
+    RayKind file_kind = RayKind::ClosestHit;
+    if (kind == "camera") {
+        rays = camera_ray_set(scene, w, h);
+    } else if (kind == "shadow") {
+        rays = shadow_ray_set(scene, w, h);
+        file_kind = RayKind::AnyHit;
+    } else {
+        throw UsageError("--kind: expected camera or shadow, got '" + kind + "'");
+    }
+    write_rays(p.text("--output"), file_kind, rays);
+    std::printf("wrote %zu %s rays to %s\n", rays.size(), kind.c_str(), p.text("--output").c_str());
+    return 0;
+}
+
+}  // namespace raypack::app
