@@ -1,0 +1,60 @@
+// The one entry point for scenes: picks the loader by extension or gen: prefix.
+#include "scene/load.h"
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <limits>
+#include <stdexcept>
+#include <string_view>
+
+#include "scene/nff_text.h"
+#include "scene/number_token.h"
+#include "scene/spd/spd.h"
+
+namespace raypack {
+
+SceneError::SceneError(const std::string& file, int line, const std::string& problem)
+    : std::runtime_error(file + ":" + std::to_string(line) + ": " + problem), file_(file), line_(line),
+      problem_(problem) {}
+
+namespace {
+
+/// gen:NAME:SIZE -> the SPD generator's NFF text, parsed in memory.
+Scene load_generated(const std::string& spec) {
+    const std::string_view rest = std::string_view(spec).substr(4);
+    const std::size_t colon = rest.find(':');
+    if (colon == std::string_view::npos || colon == 0)
+        throw SceneError(spec, 0, "bad generator spec: expected gen:NAME:SIZE");
+    const std::string name(rest.substr(0, colon));
+    const std::string_view size_text = rest.substr(colon + 1);
+    long long size = 0;
+    if (size_text.empty()) throw SceneError(spec, 0, "bad generator spec: missing SIZE in gen:NAME:SIZE");
+    const NumberToken r = parse_int_token(size_text, size);
+    if (r == NumberToken::NotNumber)
+        throw SceneError(spec, 0, "bad generator spec: size '" + std::string(size_text) + "' is not an integer");
+    if (r != NumberToken::Ok || size < std::numeric_limits<int>::min() || size > std::numeric_limits<int>::max())
+        throw SceneError(spec, 0, "bad generator spec: size '" + std::string(size_text) + "' out of range");
+    std::string text;
+    try {
+        text = generate_spd(name, int(size));
+    } catch (const std::invalid_argument& e) {
+        throw SceneError(spec, 0, std::string("bad generator spec: ") + e.what());
+    }
+    return load_nff_text(text, spec);
+}
+
+}  // namespace
+
+Scene load_scene(const std::string& spec) {
+    if (spec.starts_with("gen:")) return load_generated(spec);
+    std::string ext = std::filesystem::path(spec).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    if (ext == ".nff") return load_nff_file(spec);
+    if (ext == ".obj") return load_obj_file(spec);
+    throw SceneError(spec, 0,
+                     (ext.empty() ? std::string("no file extension") : "unknown scene format '" + ext + "'") +
+                         ": expected a .nff or .obj file, or gen:NAME:SIZE");
+}
+
+}  // namespace raypack

@@ -1,0 +1,304 @@
+// NFF (Haines, "Neutral File Format", scenes/nff-format.txt) as a stream of
+// whitespace-separated tokens, so that the one-line cone the SPD programs
+// write and the three-line cone the format document shows both load.
+#include <cmath>
+#include <iterator>
+#include <istream>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "scene/load.h"
+#include "scene/nff_text.h"
+#include "scene/number_token.h"
+#include "scene/read_file.h"
+#include "scene/triangulate.h"
+
+namespace raypack {
+
+namespace {
+
+/// Largest polygon we accept; checked before anything is allocated.
+constexpr long long kMaxPolygonVertices = 1'000'000;
+constexpr long long kMaxResolution = 65536;
+
+/// Tokens with the line each starts on; '#' comments run to the end of a line.
+class Tokenizer {
+public:
+    explicit Tokenizer(std::string_view text) : s_(text) {}
+
+    /// The next token, empty at the end of the text.
+    std::string_view next() {
+        skip_blank();
+        if (pos_ >= s_.size()) return {};
+        const std::size_t start = pos_;
+        while (pos_ < s_.size() && !is_blank(s_[pos_]) && s_[pos_] != '#') ++pos_;
+        line_ = cur_line_;
+        return s_.substr(start, pos_ - start);
+    }
+
+    std::string_view peek() {
+        const std::size_t pos = pos_;
+        const int cur = cur_line_, line = line_;
+        const std::string_view tok = next();
+        pos_ = pos;
+        cur_line_ = cur;
+        line_ = line;
+        return tok;
+    }
+
+    /// Line of the token last returned; at the end of the text, still the last
+    /// token's line, which is where a truncated entity stops.
+    int line() const { return line_; }
+
+private:
+    static bool is_blank(char c) { return c == ' ' || c == '\n' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+
+    void skip_blank() {
+        while (pos_ < s_.size()) {
+            const char c = s_[pos_];
+            if (c == '\n') {
+                ++cur_line_;
+                ++pos_;
+            } else if (is_blank(c)) {
+                ++pos_;
+            } else if (c == '#') {
+                while (pos_ < s_.size() && s_[pos_] != '\n') ++pos_;
+            } else {
+                break;
+            }
+        }
+    }
+
+    std::string_view s_;
+    std::size_t pos_ = 0;
+    int cur_line_ = 1;
+    int line_ = 1;
+};
+
+std::string quoted(std::string_view tok) {
+    constexpr std::size_t kMax = 40;  // keep messages readable on binary junk
+    // Appended piecewise: "'" + std::string(...) trips gcc 12's -Wrestrict.
+    std::string q(1, '\'');
+    q.append(tok.substr(0, kMax));
+    q.append(tok.size() > kMax ? "...'" : "'");
+    return q;
+}
+
+class NffParser {
+public:
+    NffParser(std::string_view text, const std::string& name) : tok_(text), name_(name) {}
+
+    Scene parse() {
+        scene_.source = name_;
+        for (std::string_view kw = tok_.next(); !kw.empty(); kw = tok_.next()) {
+            entity_ = kw;
+            entity_line_ = tok_.line();
+            if (kw == "v") viewpoint();
+            else if (kw == "b") scene_.background = vec3("background colour");
+            else if (kw == "l") light();
+            else if (kw == "f") fill();
+            else if (kw == "c") cone();
+            else if (kw == "s") sphere();
+            else if (kw == "p") polygon(false);
+            else if (kw == "pp") polygon(true);
+            else if (float x; parse_float_token(kw, x) != NumberToken::NotNumber)
+                fail(entity_line_, "unexpected number " + quoted(kw) +
+                                       " where an entity keyword was expected (too many values before it?)");
+            else
+                fail(entity_line_, "unknown keyword " + quoted(kw));
+        }
+        scene_.has_camera = camera_line_ != 0;
+        scene_.update_features();
+        return std::move(scene_);
+    }
+
+private:
+    [[noreturn]] void fail(int line, const std::string& problem) const { throw SceneError(name_, line, problem); }
+
+    /// " (p on line 12)": which entity a value belongs to.
+    std::string where() const { return " (" + quoted(entity_) + " on line " + std::to_string(entity_line_) + ")"; }
+
+    std::string_view expect_token(const std::string& what) {
+        const std::string_view t = tok_.next();
+        if (t.empty()) fail(tok_.line(), "unexpected end of file: expected " + what + where());
+        return t;
+    }
+
+    // `what` and `index` only build a message on failure, so the hot path does
+    // not allocate.
+    float number(const char* what, long long index = -1, long long of = 0) {
+        const std::string_view t = tok_.next();
+        float x = 0;
+        const NumberToken r = t.empty() ? NumberToken::NotNumber : parse_float_token(t, x);
+        if (r == NumberToken::Ok) return x;
+        std::string desc = what;
+        if (index >= 0) desc += " of vertex " + std::to_string(index + 1) + " of " + std::to_string(of);
+        if (t.empty()) fail(tok_.line(), "unexpected end of file: expected " + desc + where());
+        if (r == NumberToken::NotNumber)
+            fail(tok_.line(), "expected a number for " + desc + where() + ", got " + quoted(t));
+        if (r == NumberToken::NonFinite)
+            fail(tok_.line(), "non-finite number " + quoted(t) + " for " + desc + where());
+        fail(tok_.line(), "number " + quoted(t) + " out of range for " + desc + where());
+    }
+
+    long long integer(const std::string& what) {
+        const std::string_view t = expect_token(what);
+        long long v = 0;
+        const NumberToken r = parse_int_token(t, v);
+        if (r == NumberToken::Ok) return v;
+        if (r == NumberToken::OutOfRange) fail(tok_.line(), what + " " + quoted(t) + " out of range" + where());
+        fail(tok_.line(), "expected an integer for " + what + where() + ", got " + quoted(t));
+    }
+
+    Vec3f vec3(const char* what, long long index = -1, long long of = 0) {
+        // Three statements: argument evaluation order is unspecified.
+        Vec3f v;
+        v.x = number(what, index, of);
+        v.y = number(what, index, of);
+        v.z = number(what, index, of);
+        return v;
+    }
+
+    void keyword(std::string_view expected) {
+        const std::string_view t = expect_token(quoted(expected));
+        if (t != expected) fail(tok_.line(), "expected " + quoted(expected) + where() + ", got " + quoted(t));
+    }
+
+    /// Objects before any "f" get a default material rather than an error.
+    std::uint32_t material() {
+        if (scene_.materials.empty()) scene_.materials.push_back(Material{});
+        return std::uint32_t(scene_.materials.size() - 1);
+    }
+
+    // The spec wants "v" before any object; nothing here depends on that, so
+    // objects before it are accepted. A second "v" is an error: which one
+    // would be meant is not clear.
+    void viewpoint() {
+        if (camera_line_ != 0)
+            fail(entity_line_, "second viewpoint 'v' block (the first is on line " + std::to_string(camera_line_) + ")");
+        Camera& cam = scene_.camera;
+        keyword("from");
+        cam.from = vec3("from");
+        keyword("at");
+        cam.at = vec3("at");
+        const int at_line = tok_.line();
+        keyword("up");
+        cam.up = vec3("up");
+        const int up_line = tok_.line();
+        keyword("angle");
+        cam.fov_deg = number("angle");
+        if (!(cam.fov_deg > 0 && cam.fov_deg < 180))
+            fail(tok_.line(), "view angle " + std::to_string(cam.fov_deg) + " not in (0, 180) degrees" + where());
+        keyword("hither");
+        cam.hither = number("hither");
+        if (cam.hither < 0) fail(tok_.line(), "negative hither distance" + where());
+        keyword("resolution");
+        const long long w = integer("x resolution");
+        const long long h = integer("y resolution");
+        if (w <= 0 || h <= 0 || w > kMaxResolution || h > kMaxResolution)
+            fail(tok_.line(), "resolution " + std::to_string(w) + " x " + std::to_string(h) + " not in 1.." +
+                                  std::to_string(kMaxResolution) + where());
+        cam.width = int(w);
+        cam.height = int(h);
+        if (cam.from == cam.at) fail(at_line, "from and at coincide" + where());
+        if (cam.up == Vec3f{}) fail(up_line, "zero-length up vector" + where());
+        if (cross(cam.up, cam.at - cam.from) == Vec3f{})
+            fail(up_line, "up vector parallel to the view direction" + where());
+        camera_line_ = entity_line_;
+    }
+
+    void light() {
+        PointLight l;
+        l.position = vec3("light position");
+        // The colour is optional: present when a number follows.
+        float x;
+        if (parse_float_token(tok_.peek(), x) != NumberToken::NotNumber) {
+            l.color = vec3("light colour");
+            l.has_color = true;
+        }
+        scene_.lights.push_back(l);
+    }
+
+    void fill() {
+        Material m;
+        m.color = vec3("fill colour");
+        m.kd = number("Kd");
+        m.ks = number("Ks");
+        m.shine = number("Shine");
+        m.transmittance = number("T");
+        m.ior = number("index of refraction");
+        scene_.materials.push_back(m);
+    }
+
+    void sphere() {
+        const Vec3f c = vec3("sphere centre");
+        const float r = number("sphere radius");
+        scene_.add_sphere(c, r, material());
+    }
+
+    void cone() {
+        const Vec3f base = vec3("cone base");
+        const float base_r = number("cone base radius");
+        const Vec3f apex = vec3("cone apex");
+        const float apex_r = number("cone apex radius");
+        if (base == apex) fail(tok_.line(), "cone base and apex coincide" + where());
+        // Negative radii mean "inside only", which needs both to agree.
+        if ((base_r < 0 && apex_r > 0) || (base_r > 0 && apex_r < 0))
+            fail(tok_.line(), "cone radii of opposite signs" + where());
+        scene_.add_cone(base, base_r, apex, apex_r, material());
+    }
+
+    // A polygon of n vertices becomes n-2 triangles (triangulate_polygon). A
+    // degenerate polygon (all vertices collinear, zero Newell normal) is not an
+    // error: it loads as its fan of zero-area triangles, which no ray hits, so
+    // counts stay n-2 and generated scenes with slivers still load.
+    void polygon(bool patch) {
+        const long long n = integer("vertex count");
+        if (n < 0) fail(tok_.line(), "negative vertex count " + std::to_string(n) + where());
+        if (n < 3) fail(tok_.line(), "a polygon needs at least 3 vertices, got " + std::to_string(n) + where());
+        if (n > kMaxPolygonVertices)
+            fail(tok_.line(), "vertex count " + std::to_string(n) + " exceeds the limit of " +
+                                  std::to_string(kMaxPolygonVertices) + where());
+        verts_.resize(std::size_t(n));
+        normals_.resize(patch ? std::size_t(n) : 0);
+        for (long long i = 0; i < n; ++i) {
+            verts_[i] = vec3("position", i, n);
+            if (patch) {
+                normals_[i] = vec3("normal", i, n);
+                if (normals_[i] == Vec3f{}) fail(tok_.line(), "zero-length vertex normal" + where());
+            }
+        }
+        const std::uint32_t m = material();
+        for (const auto& t : triangulate_polygon(std::span<const Vec3f>(verts_))) {
+            if (patch)
+                scene_.add_triangle(verts_[t[0]], verts_[t[1]], verts_[t[2]], normals_[t[0]], normals_[t[1]],
+                                    normals_[t[2]], m);
+            else
+                scene_.add_triangle(verts_[t[0]], verts_[t[1]], verts_[t[2]], m);
+        }
+    }
+
+    Tokenizer tok_;
+    const std::string& name_;
+    Scene scene_;
+    std::string_view entity_;  ///< keyword of the entity being read
+    int entity_line_ = 0;
+    int camera_line_ = 0;  ///< line of the "v" block, 0 while none
+    std::vector<Vec3f> verts_, normals_;  ///< reused between polygons
+};
+
+}  // namespace
+
+Scene load_nff_text(std::string_view text, const std::string& name) { return NffParser(text, name).parse(); }
+
+Scene load_nff(std::istream& in, const std::string& name) {
+    std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    if (in.bad()) throw SceneError(name, 0, "read error");
+    return load_nff_text(text, name);
+}
+
+Scene load_nff_file(const std::string& path) { return load_nff_text(read_scene_file(path), path); }
+
+}  // namespace raypack
