@@ -84,10 +84,16 @@ private:
         }
         if (depth >= options_.max_depth) return color;
 
+        // SPD protocol (Readme, items 8 and 9): reflective and transmitting
+        // surfaces both spawn a reflection ray, weighted by Ks; transmitters
+        // also spawn a refraction ray unless total internal reflection occurs,
+        // in which case the reflection carries the transmitted share as well.
         const Vec3f reflected_dir = view - ns * (2.0f * dot(view, ns));
-        if (m.ks > 0) {
+        Vec3f reflected{};
+        if (m.ks > 0 || m.transmittance > 0) {
             ++stats.reflect_rays;
-            color += trace(secondary(above, reflected_dir), depth + 1, stats) * m.ks;
+            reflected = trace(secondary(above, reflected_dir), depth + 1, stats);
+            color += reflected * m.ks;
         }
         if (m.transmittance > 0) {
             // Snell's law; entering when the ray meets the outward side.
@@ -99,9 +105,7 @@ private:
                 const Vec3f dir = view * eta + ns * (eta * cos_i - std::sqrt(k));
                 color += trace(secondary(s.point - ng * eps, dir), depth + 1, stats) * m.transmittance;
             } else {
-                // Total internal reflection: the transmitted share is reflected.
-                ++stats.reflect_rays;
-                color += trace(secondary(above, reflected_dir), depth + 1, stats) * m.transmittance;
+                color += reflected * m.transmittance;
             }
         }
         return color;
@@ -149,6 +153,15 @@ RenderStats render_whitted(const Scene& scene, const Accel& accel, const Whitted
     stats.shadow_rays = shadow;
     stats.render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return stats;
+}
+
+}  // namespace raypack
+
+namespace raypack {
+
+Vec3f whitted_radiance(const Scene& scene, const Accel& accel, const WhittedOptions& options, const Rayf& ray) {
+    RenderStats stats;
+    return WhittedTracer(scene, accel, options).trace(ray, 1, stats);
 }
 
 }  // namespace raypack

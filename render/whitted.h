@@ -35,4 +35,7 @@ struct RenderStats {
 /// caller limits threads with tbb::global_control).
 RenderStats render_whitted(const Scene& scene, const Accel& accel, const WhittedOptions& options, Image& image);
 
+/// Colour seen along one ray (depth 1), for tests and tools.
+Vec3f whitted_radiance(const Scene& scene, const Accel& accel, const WhittedOptions& options, const Rayf& ray);
+
 }  // namespace raypack
