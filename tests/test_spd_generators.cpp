@@ -76,11 +76,27 @@ int power(int base, int exp) {
 
 }  // namespace
 
-TEST(SpdGenerators, BallsMatchesReference) { expect_matches_reference("balls", 4); }
-TEST(SpdGenerators, TetraMatchesReference) { expect_matches_reference("tetra", 6); }
-TEST(SpdGenerators, MountMatchesReference) { expect_matches_reference("mount", 6); }
-TEST(SpdGenerators, RingsMatchesReference) { expect_matches_reference("rings", 7); }
-TEST(SpdGenerators, TreeMatchesReference) { expect_matches_reference("tree", 11); }
+TEST(SpdGenerators, BallsMatchesReference) {
+    expect_matches_reference("balls", 4);
+}
+TEST(SpdGenerators, TetraMatchesReference) {
+    expect_matches_reference("tetra", 6);
+}
+TEST(SpdGenerators, MountMatchesReference) {
+    expect_matches_reference("mount", 6);
+}
+TEST(SpdGenerators, RingsMatchesReference) {
+    expect_matches_reference("rings", 7);
+}
+TEST(SpdGenerators, TreeMatchesReference) {
+    expect_matches_reference("tree", 11);
+}
+TEST(SpdGenerators, GearsMatchesReference) {
+    expect_matches_reference("gears", 4);
+}
+TEST(SpdGenerators, TeapotMatchesReference) {
+    expect_matches_reference("teapot", 6);
+}
 
 TEST(SpdGenerators, BallsCountsFollowFormula) {
     // Every sphere has nine children down to depth SIZE: sum of 9^k, k = 0..SIZE.
@@ -137,6 +153,30 @@ TEST(SpdGenerators, TreeCountsFollowFormula) {
     }
 }
 
+TEST(SpdGenerators, GearsCountsFollowFormula) {
+    // SIZE^3 gears, each two 144-gon faces and 4*36 side quads, plus the floor.
+    for (int size = 1; size <= 3; ++size) {
+        const std::string text = raypack::generate_spd("gears", size);
+        const int gears = size * size * size;
+        EXPECT_EQ(count_keywords(text)["p"], gears * (2 + 4 * 36) + 1) << "size " << size;
+        int big_faces = 0;
+        for (const std::string& line : split_lines(text))
+            if (line == "p 144") ++big_faces;
+        EXPECT_EQ(big_faces, 2 * gears) << "size " << size;
+        EXPECT_EQ(count_keywords(text)["l"], 5) << "size " << size;
+    }
+}
+
+TEST(SpdGenerators, TeapotCountsFollowFormula) {
+    // 32 patches x SIZE^2 cells x 2 triangles, less the 8*SIZE degenerate
+    // ones at the lid and bottom cusps; SIZE^2 board squares.
+    for (int size = 2; size <= 4; ++size) {
+        auto counts = count_keywords(raypack::generate_spd("teapot", size));
+        EXPECT_EQ(counts["pp"], 64 * size * size - 8 * size) << "size " << size;
+        EXPECT_EQ(counts["p"], size * size) << "size " << size;
+    }
+}
+
 TEST(SpdGenerators, ListsGeneratorsWithDefaults) {
     const auto gens = raypack::spd_generators();
     std::map<std::string, int> defaults;
@@ -149,6 +189,9 @@ TEST(SpdGenerators, ListsGeneratorsWithDefaults) {
     EXPECT_EQ(defaults["mount"], 6);
     EXPECT_EQ(defaults["rings"], 7);
     EXPECT_EQ(defaults["tree"], 11);
+    EXPECT_EQ(defaults["gears"], 4);
+    EXPECT_EQ(defaults["teapot"], 6);
+    EXPECT_EQ(gens.size(), 7u);
 }
 
 TEST(SpdGenerators, RejectsUnknownNamesAndBadSizes) {

@@ -29,7 +29,8 @@ ChildDirections make_child_directions() {
     ChildDirections out{};
     for (int set = 0; set < 3; ++set) {
         const Mat4 spin = rotate_matrix(Axis::Z, set * 2.0 * kPi / 3.0);
-        for (int v = 0; v < 3; ++v) out[static_cast<std::size_t>(set * 3 + v)] = transform_coord(trio[static_cast<std::size_t>(v)], spin);
+        for (int v = 0; v < 3; ++v)
+            out[static_cast<std::size_t>(set * 3 + v)] = transform_coord(trio[static_cast<std::size_t>(v)], spin);
     }
     return out;
 }
@@ -46,8 +47,7 @@ Mat4 rotation_from_z(const Vec3& direction) {
 
 /// CENTER: position and radius. DIRECTION: unit direction from the parent in
 /// xyz, child/parent radius ratio in w.
-void output_flake(NffWriter& out, const ChildDirections& dirs, int depth, const Vec4& center,
-                  const Vec4& direction) {
+void output_flake(NffWriter& out, const ChildDirections& dirs, int depth, const Vec4& center, const Vec4& direction) {
     out.sphere(center);
     if (depth <= 0) return;
 

@@ -11,5 +11,7 @@ std::string generate_tetra(int size);
 std::string generate_mount(int size);
 std::string generate_rings(int size);
 std::string generate_tree(int size);
+std::string generate_gears(int size);
+std::string generate_teapot(int size);
 
 }  // namespace raypack::spd

@@ -100,8 +100,7 @@ void grow_mountain(NffWriter& out, const MountainGrid& g, int width, int x, int 
     const double right = (z.lr + z.ur) / 2.0 + rise * displacement(g, x + width, y + half);
     const double upper = (z.ur + z.ul) / 2.0 + rise * displacement(g, x + half, y + width);
     const double left = (z.ul + z.ll) / 2.0 + rise * displacement(g, x, y + half);
-    const double middle =
-        (z.ll + z.lr + z.ur + z.ul) / 4.0 + 1.4142136 * rise * displacement(g, x + half, y + half);
+    const double middle = (z.ll + z.lr + z.ur + z.ul) / 4.0 + 1.4142136 * rise * displacement(g, x + half, y + half);
 
     grow_mountain(out, g, half, x, y, {z.ll, lower, middle, left});
     grow_mountain(out, g, half, x + half, y, {lower, z.lr, right, middle});

@@ -51,8 +51,8 @@ void NffWriter::background(const Vec3& color) {
     text_ += '\n';
 }
 
-void NffWriter::viewpoint(const Vec3& from, const Vec3& at, const Vec3& up, double fov_deg, double hither,
-                          int res_x, int res_y) {
+void NffWriter::viewpoint(const Vec3& from, const Vec3& at, const Vec3& up, double fov_deg, double hither, int res_x,
+                          int res_y) {
     text_ += "v\nfrom ";
     vec(from);
     text_ += "\nat ";
@@ -123,11 +123,9 @@ void NffWriter::polygon(std::span<const Vec3> vertices) {
     }
 }
 
-void NffWriter::polygon_patch(std::span<const Vec3> vertices, std::span<const Vec3> normals) {
-    const std::vector<std::size_t> kept = distinct_vertices(vertices);
-    if (kept.size() < 3) return;
-    text_ += "pp " + std::to_string(kept.size()) + '\n';
-    for (std::size_t i : kept) {
+void NffWriter::triangle_patch(const std::array<Vec3, 3>& vertices, const std::array<Vec3, 3>& normals) {
+    text_ += "pp 3\n";
+    for (std::size_t i = 0; i < 3; ++i) {
         vec(vertices[i]);
         text_ += ' ';
         vec(normals[i]);

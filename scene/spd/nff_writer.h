@@ -3,6 +3,7 @@
 // 1987, "A Proposal for Standard Graphics Environments"; NFF as documented in
 // scenes/nff-format.txt): one statement per call, numbers printed with C's
 // %g, cones and cylinders on one line ("curves" mode).
+#include <array>
 #include <span>
 #include <string>
 
@@ -15,13 +16,13 @@ public:
     void background(const Vec3& color);
     /// The "v" block. The SPD programs also pass an aspect ratio, which NFF
     /// does not carry, so it is not a parameter here.
-    void viewpoint(const Vec3& from, const Vec3& at, const Vec3& up, double fov_deg, double hither,
-                   int res_x, int res_y);
+    void viewpoint(const Vec3& from, const Vec3& at, const Vec3& up, double fov_deg, double hither, int res_x,
+                   int res_y);
     void light(const Vec3& position);
     /// The "f" line. ka and ks_spec are not in NFF; the highlight half-angle
     /// (degrees) becomes a Phong exponent the way the SPD library converts it.
-    void surface(const Vec3& color, double ka, double kd, double ks, double ks_spec, double highlight_deg,
-                 double kt, double ior);
+    void surface(const Vec3& color, double ka, double kd, double ks, double ks_spec, double highlight_deg, double kt,
+                 double ior);
     /// Center in xyz, radius in w.
     void sphere(const Vec4& center);
     /// Base and apex centres in xyz, their radii in w.
@@ -29,8 +30,9 @@ public:
     /// Drops vertices that coincide with their successor (as the SPD library
     /// does) and skips the polygon if fewer than three remain.
     void polygon(std::span<const Vec3> vertices);
-    /// Polygon with per-vertex normals ("pp"), same degeneracy rule.
-    void polygon_patch(std::span<const Vec3> vertices, std::span<const Vec3> normals);
+    /// Triangle with per-vertex normals ("pp 3"). The SPD library sends
+    /// patches through its triangle splitter, which does no duplicate check.
+    void triangle_patch(const std::array<Vec3, 3>& vertices, const std::array<Vec3, 3>& normals);
 
     const std::string& text() const { return text_; }
     std::string take() { return std::move(text_); }

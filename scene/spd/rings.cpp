@@ -35,7 +35,8 @@ RingVertices make_ring_vertices(double tube_radius) {
         const double z_rotation = kPi * (2.0 * static_cast<double>(p - 1) + 1.0) / 5.0;
         const Mat4 turn = rotate_matrix(Axis::Z, z_rotation);
         for (int i = 0; i < 5; ++i)
-            v[static_cast<std::size_t>(5 * p + i)] = transform_point(transform_point(v[static_cast<std::size_t>(i)], tip), turn);
+            v[static_cast<std::size_t>(5 * p + i)] =
+                transform_point(transform_point(v[static_cast<std::size_t>(i)], tip), turn);
     }
     return v;
 }

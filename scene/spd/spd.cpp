@@ -19,7 +19,7 @@ struct Entry {
 };
 
 // Default size factors as in SPD 3.14. SPD itself has no upper bound; ours
-// keep the output within a few million primitives, and mount stops at 7
+// keep a scene under about a million primitives, and mount stops at 7
 // because its original hash shifts by (7 - size) bits.
 constexpr Entry kGenerators[] = {
     {"balls", 4, 6, spd::generate_balls},
@@ -27,6 +27,8 @@ constexpr Entry kGenerators[] = {
     {"mount", 6, 7, spd::generate_mount},
     {"rings", 7, 20, spd::generate_rings},
     {"tree", 11, 18, spd::generate_tree},
+    {"gears", 4, 12, spd::generate_gears},
+    {"teapot", 6, 64, spd::generate_teapot},
 };
 
 std::string valid_names() {

@@ -62,8 +62,8 @@ std::string generate_tetra(int size) {
     NffWriter out;
     out.background({0.078, 0.361, 0.753});
     // Kay & Kajiya's view and light, moved to SPD's world coordinates.
-    out.viewpoint({1.022846, -3.177154, -2.174512}, {-0.004103, -0.004103, 0.216539},
-                  {-0.816497, -0.816497, 0.816497}, 45.0, 1.0, 512, 512);
+    out.viewpoint({1.022846, -3.177154, -2.174512}, {-0.004103, -0.004103, 0.216539}, {-0.816497, -0.816497, 0.816497},
+                  45.0, 1.0, 512, 512);
     out.light({2.0, -18.0, -5.0});
     out.surface({1.0, 0.2, 0.2}, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0);
     create_tetra(out, size, {0.0, 0.0, 0.0, 1.0});

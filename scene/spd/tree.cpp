@@ -11,10 +11,10 @@ namespace raypack::spd {
 namespace {
 
 // Shape of the tree.
-constexpr double kBranchAngle[2] = {40.0, 25.0};      // degrees from the parent axis
-constexpr double kContraction[2] = {0.65, 0.70};      // child length / parent length
+constexpr double kBranchAngle[2] = {40.0, 25.0};         // degrees from the parent axis
+constexpr double kContraction[2] = {0.65, 0.70};         // child length / parent length
 constexpr double kDivergence[2] = {90.0, 140.0 + 90.0};  // degrees about the parent axis
-constexpr double kDiameterRatio = 0.67;               // child width / parent width
+constexpr double kDiameterRatio = 0.67;                  // child width / parent width
 constexpr double kWidthToHeight = 0.15;
 
 /// Parent-to-child transform of each branch: scale, lift to the parent's
@@ -54,9 +54,9 @@ std::string generate_tree(int size) {
     NffWriter out;
     out.background({0.078, 0.361, 0.753});
     out.viewpoint({4.5, 0.4, 2.0}, {0.0, 0.0, 1.5}, {0.0, 0.0, 1.0}, 45.0, 1.0, 512, 512);
-    for (const Vec3& l : {Vec3{-5.0, 5.0, 50.0}, Vec3{30.0, -30.0, 30.0}, Vec3{-40.0, -30.0, 20.0},
-                          Vec3{10.0, 30.0, 40.0}, Vec3{-30.0, 40.0, 10.0}, Vec3{50.0, 25.0, 20.0},
-                          Vec3{-10.0, -60.0, 30.0}})
+    for (const Vec3& l :
+         {Vec3{-5.0, 5.0, 50.0}, Vec3{30.0, -30.0, 30.0}, Vec3{-40.0, -30.0, 20.0}, Vec3{10.0, 30.0, 40.0},
+          Vec3{-30.0, 40.0, 10.0}, Vec3{50.0, 25.0, 20.0}, Vec3{-10.0, -60.0, 30.0}})
         out.light(l);
 
     // Green field.
