@@ -1,0 +1,149 @@
+// The raypack command line: outputs other tools rely on, and bad input
+// answered with a message and a non-zero status, never a crash or a
+// half-written file.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "scene/ray_file.h"
+#include "scene/spd/spd.h"
+
+namespace raypack {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Result {
+    int status;
+    std::string output;  // stdout and stderr together
+};
+
+Result run(const std::string& args) {
+    const std::string cmd = std::string(RAYPACK_CLI) + " " + args + " 2>&1";
+    FILE* pipe = popen(cmd.c_str(), "r");
+    std::string out;
+    std::array<char, 4096> buf;
+    std::size_t n;
+    while ((n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0) out.append(buf.data(), n);
+    const int status = pclose(pipe);
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+fs::path temp_dir() {
+    const fs::path d = fs::temp_directory_path() / "raypack_test_cli";
+    fs::create_directories(d);
+    return d;
+}
+
+std::string scene_path(const std::string& name) { return std::string(RAYPACK_SOURCE_DIR) + "/scenes/" + name; }
+
+std::string slurp(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+TEST(Cli, InfoReportsCountsCameraLightsAndFeatures) {
+    const Result r = run("info " + scene_path("rings.nff"));
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("spheres    4200"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("cones      4200"), std::string::npos);
+    EXPECT_NE(r.output.find("lights: 3"), std::string::npos);
+    EXPECT_NE(r.output.find("features: spheres triangles cones reflection"), std::string::npos);
+}
+
+TEST(Cli, GenReproducesTheSpdFile) {
+    const fs::path out = temp_dir() / "balls.nff";
+    const Result r = run("gen balls --size 4 -o " + out.string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(slurp(out), slurp(scene_path("balls.nff")));
+}
+
+TEST(Cli, RenderWritesTheImageAndSaysWhere) {
+    const fs::path out = temp_dir() / "tetra.png";
+    fs::remove(out);
+    const Result r = run("render gen:tetra:3 -o " + out.string() + " --res 64 48 --depth 2 --threads 1");
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(fs::exists(out));
+    EXPECT_NE(r.output.find("64x48"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find(out.string()), std::string::npos);
+}
+
+TEST(Cli, TraceAnswersClosestAndAnyHitWithJson) {
+    const fs::path dir = temp_dir();
+    const std::string scene = "gen:balls:2";
+    ASSERT_EQ(run("rays " + scene + " --kind camera --res 32 32 -o " + (dir / "c.rays").string()).status, 0);
+    ASSERT_EQ(run("rays " + scene + " --kind shadow --res 32 32 -o " + (dir / "s.rays").string()).status, 0);
+    for (const char* kind : {"c", "s"}) {
+        const std::string rays = (dir / (std::string(kind) + ".rays")).string();
+        const std::string hits = (dir / (std::string(kind) + ".hits")).string();
+        const Result r = run("trace " + scene + " --rays " + rays + " -o " + hits + " --repeat 3 --threads 2 --json");
+        ASSERT_EQ(r.status, 0) << r.output;
+        const auto j = nlohmann::json::parse(r.output);
+        for (const char* key : {"rays", "build_ms", "trace_ms_median", "mrays_per_s_median", "hits"})
+            EXPECT_TRUE(j.contains(key)) << key;
+        const RayFile file = read_rays(rays);
+        const auto h = read_hits(hits);
+        ASSERT_EQ(h.size(), file.rays.size());
+        EXPECT_EQ(j["rays"].get<std::size_t>(), file.rays.size());
+        std::size_t found = 0;
+        for (const auto& x : h) found += x.found();
+        EXPECT_EQ(j["hits"].get<std::size_t>(), found);
+        if (file.kind == RayKind::ClosestHit) EXPECT_EQ(found, file.rays.size());  // balls: every eye ray hits
+        else EXPECT_GT(found, 0u);  // some points are in shadow
+    }
+}
+
+TEST(Cli, BadFlagsAreUsageErrors) {
+    struct Case {
+        std::string args, phrase;
+    };
+    const Case cases[] = {
+        {"render " + scene_path("tetra.nff") + " --bogus", "unknown option '--bogus'"},
+        {"render " + scene_path("tetra.nff") + " --res 0 10", "--res must be between 1 and 65536"},
+        {"render " + scene_path("tetra.nff") + " --res 64", "--res needs 2 value(s)"},
+        {"render " + scene_path("tetra.nff") + " --depth x", "--depth expects an integer"},
+        {"render " + scene_path("tetra.nff") + " --accel octopus", "unknown structure 'octopus'"},
+        {"trace " + scene_path("tetra.nff"), "missing --rays"},
+        {"gen nosuch -o x.nff", "unknown generator 'nosuch'"},
+        {"gen balls --size 99 -o x.nff", "--size must be between 1 and"},
+        {"frobnicate", "unknown command 'frobnicate'"},
+    };
+    for (const Case& c : cases) {
+        const Result r = run(c.args);
+        EXPECT_EQ(r.status, 2) << c.args << "\n" << r.output;
+        EXPECT_NE(r.output.find(c.phrase), std::string::npos) << c.args << "\n" << r.output;
+    }
+}
+
+TEST(Cli, BadInputNamesTheFileAndLeavesOutputsAlone) {
+    const fs::path dir = temp_dir();
+    const fs::path bad = dir / "bad.nff";
+    { std::ofstream(bad) << "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 45\nhither 1\nresolution 8 8\ns 0 0 nan 1\n"; }
+    const fs::path out = dir / "keep.png";
+    { std::ofstream(out) << "previous image"; }
+    const Result r = run("render " + bad.string() + " -o " + out.string());
+    EXPECT_EQ(r.status, 1);
+    EXPECT_NE(r.output.find(bad.string() + ":8:"), std::string::npos) << r.output;
+    EXPECT_EQ(slurp(out), "previous image");
+
+    const Result missing = run("info " + (dir / "no_such_scene.nff").string());
+    EXPECT_EQ(missing.status, 1);
+    EXPECT_NE(missing.output.find("no_such_scene.nff"), std::string::npos) << missing.output;
+
+    const fs::path junk = dir / "junk.rays";
+    { std::ofstream(junk) << "not rays at all"; }
+    const Result rays = run("trace gen:tetra:1 --rays " + junk.string());
+    EXPECT_EQ(rays.status, 1);
+    EXPECT_NE(rays.output.find("junk.rays"), std::string::npos) << rays.output;
+}
+
+}  // namespace
+}  // namespace raypack
