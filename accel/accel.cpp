@@ -5,17 +5,27 @@
 
 #include "accel/brute/brute_force.h"
 #include "accel/bvh/bvh2_accel.h"
+#ifdef RAYPACK_HAVE_EMBREE
+#include "accel/embree/embree_accel.h"
+#endif
 
 namespace raypack {
 
 std::span<const char* const> accel_kinds() {
+#ifdef RAYPACK_HAVE_EMBREE
+    static constexpr std::array<const char*, 3> kinds = {"bvh2", "brute", "embree"};
+#else
     static constexpr std::array<const char*, 2> kinds = {"bvh2", "brute"};
+#endif
     return kinds;
 }
 
 std::unique_ptr<Accel> build_accel(const Scene& scene, const AccelConfig& config) {
     if (config.kind == "bvh2") return std::make_unique<Bvh2Accel>(scene, config);
     if (config.kind == "brute") return std::make_unique<BruteForce>(scene, config.kernels);
+#ifdef RAYPACK_HAVE_EMBREE
+    if (config.kind == "embree") return std::make_unique<EmbreeAccel>(scene);
+#endif
     throw std::invalid_argument("unknown acceleration structure '" + config.kind + "' (expected bvh2 or brute)");
 }
 

@@ -1,0 +1,59 @@
+#pragma once
+// Embree 3 as an independent reference: same scene, same rays, a different
+// BVH, different primitive tests. Compiled only when CMake found Embree.
+#ifdef RAYPACK_HAVE_EMBREE
+
+#include <atomic>
+#include <cstdint>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <embree3/rtcore.h>
+
+#include "accel/accel.h"
+
+namespace raypack {
+
+/// One NFF cone in its own frame: origin at the base centre, w along the
+/// axis, u and v across it; radius rb + k z for 0 <= z <= h.
+struct EmbreeCone {
+    Vec3d base, u, v, w;
+    double h = 0, rb = 0, k = 0;
+};
+
+/// Triangles become RTC_GEOMETRY_TYPE_TRIANGLE and spheres
+/// RTC_GEOMETRY_TYPE_SPHERE_POINT. NFF cones are user geometry with their own
+/// intersector (see the .cpp for why not RTC_GEOMETRY_TYPE_CONE_LINEAR_CURVE).
+/// Hits report raypack's global primitive numbers.
+class EmbreeAccel final : public Accel {
+public:
+    explicit EmbreeAccel(const Scene& scene);
+    ~EmbreeAccel() override;
+    EmbreeAccel(const EmbreeAccel&) = delete;
+    EmbreeAccel& operator=(const EmbreeAccel&) = delete;
+
+    void intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const override;
+    void occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override;
+    const AccelStats& stats() const override { return stats_; }
+
+private:
+    void build(const Scene& scene);
+    static bool memory_monitor(void* self, ssize_t bytes, bool post);
+    static void on_error(void* self, RTCError code, const char* message);
+    [[noreturn]] void fail(const std::string& what) const;
+
+    RTCDevice device_ = nullptr;
+    RTCScene scene_ = nullptr;
+    /// Embree geometry id -> (primID -> raypack's global primitive number).
+    std::vector<std::vector<std::uint32_t>> to_global_;
+    std::vector<EmbreeCone> cones_;  ///< user data of the cone geometry
+    std::atomic<std::int64_t> allocated_{0};
+    mutable std::mutex error_mutex_;
+    std::string first_error_;  ///< Embree's own message, reported by fail()
+    AccelStats stats_;
+};
+
+}  // namespace raypack
+
+#endif  // RAYPACK_HAVE_EMBREE
