@@ -1,6 +1,8 @@
 #pragma once
 // Axis-aligned boxes and the scalar slab test (Kay & Kajiya 1986).
+#include <cmath>
 #include <limits>
+#include <utility>
 
 #include "kernels/ray.h"
 
@@ -36,19 +38,36 @@ Vec3<T> reciprocal(const Vec3<T>& d) {
     return {T(1) / d.x, T(1) / d.y, T(1) / d.z};
 }
 
+/// gamma(n) of Higham / pbrt: bound on the relative error of n roundings.
+template <class T>
+constexpr T rounding_gamma(int n) {
+    constexpr T eps = std::numeric_limits<T>::epsilon() / 2;
+    return (T(n) * eps) / (T(1) - T(n) * eps);
+}
+
 /// Slab test: does the ray meet the box within [tnear, tfar]? On success
-/// `entry` is where it enters (clamped to tnear). An origin exactly on a slab
-/// plane with a parallel direction gives 0 * inf = NaN; the min/max order
-/// below makes a NaN drop out so that such a ray counts as inside that slab.
+/// `entry` is where it enters (clamped to tnear). Boundaries count as inside.
+/// Conservative: each far distance is widened by 1 + 2 gamma(3) so rounding
+/// never culls a box the exact ray touches, e.g. a ray aimed exactly at a
+/// mesh vertex lying on the box's corner (Ize, "Robust BVH Ray Traversal",
+/// JCGT 2013; pbrt-v4 Bounds3::IntersectP).
+/// A direction component of +-0 means the ray runs parallel to that slab: it
+/// is inside the slab for every t or for none, decided from the origin alone
+/// (multiplying through the infinite reciprocal would give 0 * inf = NaN on a
+/// plane, and +-inf of the wrong sign on the far plane for a -0 component).
 template <class T>
 bool intersect_aabb(const Vec3<T>& org, const Vec3<T>& inv_dir, const Box3<T>& box, T tnear, T tfar,
                     T& entry) {
     T t0 = tnear, t1 = tfar;
     for (int a = 0; a < 3; ++a) {
+        if (std::isinf(inv_dir[a])) {
+            if (org[a] < box.lo[a] || org[a] > box.hi[a]) return false;
+            continue;
+        }
         T ta = (box.lo[a] - org[a]) * inv_dir[a];
         T tb = (box.hi[a] - org[a]) * inv_dir[a];
         if (ta > tb) std::swap(ta, tb);
-        // Written so that a NaN (0 * inf) leaves t0 / t1 unchanged.
+        tb *= T(1) + T(2) * rounding_gamma<T>(3);
         t0 = ta > t0 ? ta : t0;
         t1 = tb < t1 ? tb : t1;
     }

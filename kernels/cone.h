@@ -17,21 +17,32 @@ bool intersect_cone(const Ray<T>& ray, const Vec3<T>& base, T base_radius, const
     const T h = length(axis);
     const Vec3<T> w = axis / h;
     const T k = (apex_radius - base_radius) / h;
-    const Vec3<T> co = ray.org - base;
-    const T s0 = dot(co, w);        // axial position of the origin
-    const T ds = dot(ray.dir, w);   // axial speed
+    // Move the origin to the ray's closest approach to the cone's middle
+    // first: for a thin cone seen from afar, |co|^2 - r0^2 would otherwise
+    // lose r0^2 to cancellation (the re-centring of Haines et al., "Precision
+    // Improvements for Ray/Sphere Intersection", Ray Tracing Gems ch. 7).
+    const T dd = dot(ray.dir, ray.dir);
+    const T t_mid = dot((base + apex) * T(0.5) - ray.org, ray.dir) / dd;
+    const Vec3<T> co = ray.org + ray.dir * t_mid - base;
+    // Work with the components perpendicular to the axis, so that nothing
+    // large is squared and then subtracted.
+    const T s0 = dot(co, w);         // axial position of the (moved) origin
+    const T ds = dot(ray.dir, w);    // axial speed
+    const Vec3<T> co_perp = co - w * s0;
+    const Vec3<T> d_perp = ray.dir - w * ds;
     const T r0 = base_radius + k * s0;
-    const T a = dot(ray.dir, ray.dir) - ds * ds - k * k * ds * ds;
-    const T b = dot(co, ray.dir) - s0 * ds - r0 * k * ds;
-    const T c = dot(co, co) - s0 * s0 - r0 * r0;
+    const T a = dot(d_perp, d_perp) - k * k * ds * ds;
+    const T b = dot(co_perp, d_perp) - r0 * k * ds;
+    const T c = dot(co_perp, co_perp) - r0 * r0;
     T t0, t1;
     if (!solve_quadratic_half(a, b, c, t0, t1)) return false;
     const T roots[2] = {t0, t1};
     for (T tr : roots) {
-        if (!(tr >= ray.tnear && tr <= ray.tfar)) continue;
+        const T tt = t_mid + tr;
+        if (!(tt >= ray.tnear && tt <= ray.tfar)) continue;
         const T s = s0 + tr * ds;
         if (s >= T(0) && s <= h && base_radius + k * s >= T(0)) {
-            t = tr;
+            t = tt;
             s_frac = s / h;
             return true;
         }
