@@ -20,13 +20,22 @@ std::span<const char* const> accel_kinds() {
     return kinds;
 }
 
+std::string accel_kinds_list() {
+    std::string list;
+    for (const char* k : accel_kinds()) {
+        if (!list.empty()) list += '|';
+        list += k;
+    }
+    return list;
+}
+
 std::unique_ptr<Accel> build_accel(const Scene& scene, const AccelConfig& config) {
     if (config.kind == "bvh2") return std::make_unique<Bvh2Accel>(scene, config);
     if (config.kind == "brute") return std::make_unique<BruteForce>(scene, config.kernels);
 #ifdef RAYPACK_HAVE_EMBREE
     if (config.kind == "embree") return std::make_unique<EmbreeAccel>(scene);
 #endif
-    throw std::invalid_argument("unknown acceleration structure '" + config.kind + "' (expected bvh2 or brute)");
+    throw std::invalid_argument("unknown acceleration structure '" + config.kind + "' (expected " + accel_kinds_list() + ")");
 }
 
 }  // namespace raypack

@@ -56,6 +56,8 @@ public:
 
 /// Names accepted by AccelConfig::kind.
 std::span<const char* const> accel_kinds();
+/// The same names joined by '|', for help and error messages.
+std::string accel_kinds_list();
 
 /// Builds the structure the config names over every primitive of `scene`.
 /// The scene must outlive the structure. Throws std::invalid_argument for an

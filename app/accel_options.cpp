@@ -10,7 +10,7 @@ std::vector<OptionSpec> accel_option_specs() {
 }
 
 std::string accel_options_help() {
-    return "  --accel bvh2|brute            acceleration structure (default bvh2)\n"
+    return "  --accel " + accel_kinds_list() + "  acceleration structure (default bvh2)\n"
            "  --sphere geometric|algebraic  ray-sphere test (default geometric)\n"
            "  --triangle moeller|plane      ray-triangle test (default moeller)\n";
 }
@@ -20,7 +20,8 @@ AccelConfig accel_config_from(const ParsedArgs& args) {
     config.kind = args.text("--accel", "bvh2");
     bool known = false;
     for (const char* k : accel_kinds()) known |= config.kind == k;
-    if (!known) throw UsageError("--accel: unknown structure '" + config.kind + "' (expected bvh2 or brute)");
+    if (!known)
+        throw UsageError("--accel: unknown structure '" + config.kind + "' (expected " + accel_kinds_list() + ")");
     const std::string sphere = args.text("--sphere", "geometric");
     if (sphere == "geometric") config.kernels.sphere = SphereMethod::Geometric;
     else if (sphere == "algebraic") config.kernels.sphere = SphereMethod::Algebraic;
