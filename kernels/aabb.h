@@ -1,10 +1,13 @@
 #pragma once
-// Axis-aligned boxes and the scalar slab test (Kay & Kajiya 1986).
+// Axis-aligned boxes and the slab test (Kay & Kajiya 1986), written once for
+// every lane type (see kernels/simd.h): K rays against one box, or one ray
+// against K boxes stored as SoA.
 #include <cmath>
 #include <limits>
 #include <utility>
 
 #include "kernels/ray.h"
+#include "kernels/simd.h"
 
 namespace raypack {
 
@@ -30,13 +33,7 @@ struct Box3 {
 
 using Box3f = Box3<float>;
 
-/// Reciprocal direction for the slab test. A zero component gives +-inf with
-/// the sign of the zero, so slabs the ray runs parallel to become (-inf, +inf)
-/// when the origin lies strictly between the planes and empty otherwise.
-template <class T>
-Vec3<T> reciprocal(const Vec3<T>& d) {
-    return {T(1) / d.x, T(1) / d.y, T(1) / d.z};
-}
+enum class SlabMethod { Plain, Robust };
 
 /// gamma(n) of Higham / pbrt: bound on the relative error of n roundings.
 template <class T>
@@ -45,34 +42,89 @@ constexpr T rounding_gamma(int n) {
     return (T(n) * eps) / (T(1) - T(n) * eps);
 }
 
-/// Slab test: does the ray meet the box within [tnear, tfar]? On success
-/// `entry` is where it enters (clamped to tnear). Boundaries count as inside.
-/// Conservative: each far distance is widened by 1 + 2 gamma(3) so rounding
-/// never culls a box the exact ray touches, e.g. a ray aimed exactly at a
-/// mesh vertex lying on the box's corner (Ize, "Robust BVH Ray Traversal",
-/// JCGT 2013; pbrt-v4 Bounds3::IntersectP).
-/// A direction component of +-0 means the ray runs parallel to that slab: it
-/// is inside the slab for every t or for none, decided from the origin alone
-/// (multiplying through the infinite reciprocal would give 0 * inf = NaN on a
-/// plane, and +-inf of the wrong sign on the far plane for a -0 component).
-template <class T>
-bool intersect_aabb(const Vec3<T>& org, const Vec3<T>& inv_dir, const Box3<T>& box, T tnear, T tfar,
-                    T& entry) {
-    T t0 = tnear, t1 = tfar;
-    for (int a = 0; a < 3; ++a) {
-        if (std::isinf(inv_dir[a])) {
-            if (org[a] < box.lo[a] || org[a] > box.hi[a]) return false;
-            continue;
-        }
-        T ta = (box.lo[a] - org[a]) * inv_dir[a];
-        T tb = (box.hi[a] - org[a]) * inv_dir[a];
-        if (ta > tb) std::swap(ta, tb);
-        tb *= T(1) + T(2) * rounding_gamma<T>(3);
-        t0 = ta > t0 ? ta : t0;
-        t1 = tb < t1 ? tb : t1;
+/// Smallest direction magnitude the slab tests divide by. A zero or tiny
+/// component becomes +-kMinRcpInput (keeping its sign), so the reciprocal is
+/// finite: a ray on a slab plane then gives 0 * 1e18 = 0 instead of
+/// 0 * inf = NaN, and rays parallel to a slab need no branch (as Embree does).
+inline constexpr float kMinRcpInput = 1e-18f;
+
+/// Reciprocal direction for the slab tests, for any lane type.
+template <class F>
+RAYPACK_INLINE Vec3<F> reciprocal(const Vec3<F>& d) {
+    const F tiny(kMinRcpInput);
+    auto safe = [&](const F& c) { return select(vabs(c) < tiny, copysign_of(tiny, c), c); };
+    return {F(1) / safe(d.x), F(1) / safe(d.y), F(1) / safe(d.z)};
+}
+
+/// What a slab test needs of a ray: origin, reciprocal direction and, for the
+/// plain test, origin * reciprocal direction, all computed once per ray.
+template <class F>
+struct SlabRay {
+    Vec3<F> org, rdir, org_rdir;
+    F tnear, tfar;
+};
+
+template <class F>
+RAYPACK_INLINE SlabRay<F> make_slab_ray(const Vec3<F>& org, const Vec3<F>& rdir, const F& tnear, const F& tfar) {
+    return {org, rdir, {org.x * rdir.x, org.y * rdir.y, org.z * rdir.z}, tnear, tfar};
+}
+
+/// Slab test of lanes of rays against lanes of boxes (either side may be
+/// broadcast). Returns the lanes of `valid` whose ray meets the box within
+/// [tnear, tfar]; `entry` gets the entry distance (clamped to tnear).
+///
+/// Plain, for speed: each plane distance is one fused multiply-add,
+/// lo * rdir - org * rdir (Embree's form); a ray lying exactly in a slab
+/// plane and parallel to it counts as leaving the slab at once, as in Embree.
+///
+/// Robust, for the reference path and wherever exactness matters:
+/// - distances as (lo - org) * rdir, the far one widened by 1 + 2 gamma(3), so
+///   that rounding never culls a box the exact ray touches, e.g. a ray aimed
+///   exactly at a mesh vertex on the box's corner (Ize, "Robust BVH Ray
+///   Traversal", JCGT 2013; pbrt-v4 Bounds3::IntersectP);
+/// - a component reciprocal() clamped (a ray parallel to that slab) bounds
+///   nothing: the ray is inside the slab for all t if its origin is within
+///   [lo, hi], boundaries included, and nowhere otherwise.
+template <SlabMethod Method, class F>
+RAYPACK_INLINE mask_of<F> intersect_box(const mask_of<F>& valid, const SlabRay<F>& ray, const Vec3<F>& lo,
+                                        const Vec3<F>& hi, F& entry) {
+    const Vec3<F>& org = ray.org;
+    const Vec3<F>& rdir = ray.rdir;
+    F tx0, tx1, ty0, ty1, tz0, tz1;
+    mask_of<F> ok = valid;
+    if constexpr (Method == SlabMethod::Plain) {
+        tx0 = vfmadd(lo.x, rdir.x, -ray.org_rdir.x), tx1 = vfmadd(hi.x, rdir.x, -ray.org_rdir.x);
+        ty0 = vfmadd(lo.y, rdir.y, -ray.org_rdir.y), ty1 = vfmadd(hi.y, rdir.y, -ray.org_rdir.y);
+        tz0 = vfmadd(lo.z, rdir.z, -ray.org_rdir.z), tz1 = vfmadd(hi.z, rdir.z, -ray.org_rdir.z);
+    } else {
+        tx0 = (lo.x - org.x) * rdir.x, tx1 = (hi.x - org.x) * rdir.x;
+        ty0 = (lo.y - org.y) * rdir.y, ty1 = (hi.y - org.y) * rdir.y;
+        tz0 = (lo.z - org.z) * rdir.z, tz1 = (hi.z - org.z) * rdir.z;
+        // Computed exactly as reciprocal() does, so a clamped component compares equal.
+        const F huge = F(1) / F(kMinRcpInput), inf(std::numeric_limits<float>::infinity());
+        auto parallel_axis = [&](const F& o, const F& r, const F& l, const F& h, F& t0, F& t1) {
+            const auto parallel = vabs(r) >= huge;
+            ok = ok & !(parallel & ((o < l) | (o > h)));
+            t0 = select(parallel, -inf, t0);
+            t1 = select(parallel, inf, t1);
+        };
+        parallel_axis(org.x, rdir.x, lo.x, hi.x, tx0, tx1);
+        parallel_axis(org.y, rdir.y, lo.y, hi.y, ty0, ty1);
+        parallel_axis(org.z, rdir.z, lo.z, hi.z, tz0, tz1);
     }
-    entry = t0;
-    return t0 <= t1;
+    const F t_in = vmax(vmax(vmin(tx0, tx1), vmin(ty0, ty1)), vmax(vmin(tz0, tz1), ray.tnear));
+    F t_out = vmin(vmin(vmax(tx0, tx1), vmax(ty0, ty1)), vmax(tz0, tz1));
+    if constexpr (Method == SlabMethod::Robust) t_out = t_out * F(1.0f + 2.0f * rounding_gamma<float>(3));
+    t_out = vmin(t_out, ray.tfar);
+    entry = t_in;
+    return ok & (t_in <= t_out);
+}
+
+/// Scalar form used by the reference traversal: robust, one ray, one box.
+template <class T>
+RAYPACK_INLINE bool intersect_aabb(const Vec3<T>& org, const Vec3<T>& inv_dir, const Box3<T>& box, T tnear, T tfar, T& entry) {
+    const SlabRay<T> ray{org, inv_dir, {}, tnear, tfar};  // robust: org_rdir unused
+    return intersect_box<SlabMethod::Robust, T>(true, ray, box.lo, box.hi, entry);
 }
 
 }  // namespace raypack

@@ -1,0 +1,57 @@
+#pragma once
+// Rays and hits as structure of arrays over lanes: RayPacket<K> holds K rays,
+// one per lane of vfloat<K>. K = 1 is a plain scalar ray.
+#include <cstdint>
+#include <limits>
+#include <span>
+
+#include "kernels/aabb.h"
+#include "kernels/ray.h"
+#include "kernels/simd.h"
+
+namespace raypack {
+
+/// Rays in lanes of F. rdir is 1 / dir per component, precomputed once per
+/// packet for the slab tests.
+template <class F>
+struct RayLanes {
+    Vec3<F> org, dir, rdir;
+    F tnear, tfar;
+};
+
+/// Closest hits in lanes of F: t = +inf and prim = kNoPrim where nothing was hit.
+template <class F>
+struct HitLanes {
+    F t, u, v;
+    std::uint32_t prim[lanes_of<F>];
+};
+
+template <int K> using RayPacket = RayLanes<vfloat<K>>;
+template <int K> using HitPacket = HitLanes<vfloat<K>>;
+
+/// Loads up to K rays (count <= K) into a packet; the lanes past `count`
+/// repeat the last ray and come back inactive in `valid`.
+template <int K>
+RayPacket<K> load_packet(std::span<const Rayf> rays, vmask<K>& valid) {
+    using F = vfloat<K>;
+    alignas(64) float f[11][K];
+    alignas(64) float active[K];
+    const std::size_t n = rays.size();
+    for (int i = 0; i < K; ++i) {
+        const Rayf& r = rays[std::min<std::size_t>(std::size_t(i), n - 1)];
+        const Vec3f rd = reciprocal(r.dir);
+        const float vals[11] = {r.org.x, r.org.y, r.org.z, r.dir.x, r.dir.y, r.dir.z, rd.x, rd.y, rd.z, r.tnear, r.tfar};
+        for (int c = 0; c < 11; ++c) f[c][i] = vals[c];
+        active[i] = std::size_t(i) < n ? 1.0f : 0.0f;
+    }
+    RayPacket<K> p;
+    p.org = {load_lanes<F>(f[0]), load_lanes<F>(f[1]), load_lanes<F>(f[2])};
+    p.dir = {load_lanes<F>(f[3]), load_lanes<F>(f[4]), load_lanes<F>(f[5])};
+    p.rdir = {load_lanes<F>(f[6]), load_lanes<F>(f[7]), load_lanes<F>(f[8])};
+    p.tnear = load_lanes<F>(f[9]);
+    p.tfar = load_lanes<F>(f[10]);
+    valid = load_lanes<F>(active) > F(0.0f);
+    return p;
+}
+
+}  // namespace raypack
