@@ -42,6 +42,20 @@ public:
     virtual void occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const = 0;
     virtual const AccelStats& stats() const = 0;
 
+    /// Packet widths this structure traverses natively (1 is always there).
+    virtual bool supports_packet(int width) const { return width == 1; }
+    /// The same queries, traced as packets of `width` consecutive rays (the
+    /// caller orders rays so that neighbours are coherent). Width 1, or a
+    /// structure without packets, runs the single-ray path.
+    virtual void intersect_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
+        (void)width;
+        intersect(rays, hits);
+    }
+    virtual void occluded_packets(int width, std::span<const Rayf> rays, std::span<std::uint8_t> occluded_out) const {
+        (void)width;
+        occluded(rays, occluded_out);
+    }
+
     Hitf intersect1(const Rayf& ray) const {
         Hitf hit;
         intersect({&ray, 1}, {&hit, 1});

@@ -6,13 +6,14 @@
 namespace raypack::app {
 
 std::vector<OptionSpec> accel_option_specs() {
-    return {{"--accel", "", 1}, {"--sphere", "", 1}, {"--triangle", "", 1}};
+    return {{"--accel", "", 1}, {"--sphere", "", 1}, {"--triangle", "", 1}, {"--packet", "", 1}};
 }
 
 std::string accel_options_help() {
     return "  --accel " + accel_kinds_list() + "  acceleration structure (default bvh2)\n"
            "  --sphere geometric|algebraic  ray-sphere test (default geometric)\n"
-           "  --triangle moeller|plane      ray-triangle test (default moeller)\n";
+           "  --triangle moeller|plane      ray-triangle test (default moeller)\n"
+           "  --packet 1|4|8|16             rays per packet (default 1; 16 needs AVX-512)\n";
 }
 
 AccelConfig accel_config_from(const ParsedArgs& args) {
@@ -31,6 +32,16 @@ AccelConfig accel_config_from(const ParsedArgs& args) {
     else if (tri == "plane") config.kernels.triangle = TriangleMethod::Plane;
     else throw UsageError("--triangle: expected moeller or plane, got '" + tri + "'");
     return config;
+}
+
+int packet_width_from(const ParsedArgs& args, const Accel& accel) {
+    const int width = int(args.integer("--packet", 1, 1, 16));
+    if (width != 1 && width != 4 && width != 8 && width != 16)
+        throw UsageError("--packet: expected 1, 4, 8 or 16, got " + std::to_string(width));
+    if (!accel.supports_packet(width))
+        throw UsageError("--packet " + std::to_string(width) + ": not available for " + accel.stats().name +
+                         " in this build");
+    return width;
 }
 
 struct ThreadLimit::Impl {

@@ -7,9 +7,11 @@
 
 namespace raypack::app {
 
-/// --accel, --sphere, --triangle
+/// --accel, --sphere, --triangle, --packet
 std::vector<OptionSpec> accel_option_specs();
 AccelConfig accel_config_from(const ParsedArgs& args);
+/// --packet K, checked against what `accel` traverses natively.
+int packet_width_from(const ParsedArgs& args, const Accel& accel);
 std::string accel_options_help();
 
 /// --threads T: limits oneTBB for the life of the returned object.

@@ -58,6 +58,7 @@ int run_render(const Args& args) {
         throw UsageError("--res: image of more than 2^28 pixels");
 
     const auto accel = build_accel(scene, config);
+    options.packet = packet_width_from(p, *accel);
     Image image;
     const RenderStats stats = render_whitted(scene, *accel, options, image);
     t0 = std::chrono::steady_clock::now();
@@ -71,8 +72,8 @@ int run_render(const Args& args) {
                 scene.lights.size(), load_ms);
     std::printf("  structure  %s (%s), %zu nodes, SAH cost %.2f, built in %.1f ms\n", as.name.c_str(),
                 as.builder.c_str(), as.nodes, as.sah_cost, as.build_ms);
-    std::printf("  render     %dx%d, depth %d, %d threads, Whitted: %.1f ms\n", options.width, options.height,
-                options.max_depth, limit.threads(), stats.render_ms);
+    std::printf("  render     %dx%d, depth %d, %d threads, primary packets of %d, Whitted: %.1f ms\n",
+                options.width, options.height, options.max_depth, limit.threads(), options.packet, stats.render_ms);
     std::printf("  rays       eye %llu (%llu hit), reflect %llu, refract %llu, shadow %llu\n",
                 (unsigned long long)stats.eye_rays, (unsigned long long)stats.eye_hits,
                 (unsigned long long)stats.reflect_rays, (unsigned long long)stats.refract_rays,

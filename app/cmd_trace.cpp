@@ -19,7 +19,7 @@ namespace {
 constexpr std::size_t kBatch = 256;  // rays per call into the structure
 
 /// One pass over all rays, batches in parallel; returns milliseconds.
-double trace_all(const Accel& accel, const RayFile& file, std::vector<Hitf>& hits) {
+double trace_all(const Accel& accel, int packet, const RayFile& file, std::vector<Hitf>& hits) {
     const auto start = std::chrono::steady_clock::now();
     const std::size_t n = file.rays.size();
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, (n + kBatch - 1) / kBatch), [&](const auto& r) {
@@ -27,10 +27,10 @@ double trace_all(const Accel& accel, const RayFile& file, std::vector<Hitf>& hit
             const std::size_t lo = b * kBatch, hi = std::min(n, lo + kBatch);
             const std::span<const Rayf> rays(file.rays.data() + lo, hi - lo);
             if (file.kind == RayKind::ClosestHit) {
-                accel.intersect(rays, std::span<Hitf>(hits.data() + lo, hi - lo));
+                accel.intersect_packets(packet, rays, std::span<Hitf>(hits.data() + lo, hi - lo));
             } else {
                 std::uint8_t occluded[kBatch];
-                accel.occluded(rays, std::span<std::uint8_t>(occluded, hi - lo));
+                accel.occluded_packets(packet, rays, std::span<std::uint8_t>(occluded, hi - lo));
                 for (std::size_t i = lo; i < hi; ++i) {
                     hits[i] = Hitf{};
                     if (occluded[i - lo]) hits[i].prim = 0;  // rays.md: 0 = occluded
@@ -68,10 +68,11 @@ int run_trace(const Args& args) {
     const Scene scene = load_scene(p.positional()[0]);
     const RayFile file = read_rays(p.text("--rays"));
     const auto accel = build_accel(scene, config);
+    const int packet = packet_width_from(p, *accel);
     std::vector<Hitf> hits(file.rays.size());
-    trace_all(*accel, file, hits);  // warm-up, untimed
+    trace_all(*accel, packet, file, hits);  // warm-up, untimed
     std::vector<double> times;
-    for (int r = 0; r < repeat; ++r) times.push_back(trace_all(*accel, file, hits));
+    for (int r = 0; r < repeat; ++r) times.push_back(trace_all(*accel, packet, file, hits));
     std::vector<double> sorted = times;
     std::sort(sorted.begin(), sorted.end());
     const double median = sorted.size() % 2 ? sorted[sorted.size() / 2]
@@ -88,7 +89,7 @@ int run_trace(const Args& args) {
         j["scene"] = scene.source;
         j["accel"] = as.name;
         j["builder"] = as.builder;
-        j["packet"] = 1;
+        j["packet"] = packet;
         j["kind"] = file.kind == RayKind::ClosestHit ? "closest" : "any";
         j["rays"] = file.rays.size();
         j["threads"] = limit.threads();
@@ -104,8 +105,8 @@ int run_trace(const Args& args) {
         std::printf("raypack trace: %s, %zu %s rays, %s (%s) built in %.1f ms\n", scene.source.c_str(),
                     file.rays.size(), file.kind == RayKind::ClosestHit ? "closest-hit" : "any-hit", as.name.c_str(),
                     as.builder.c_str(), as.build_ms);
-        std::printf("  %d threads, %d passes: median %.2f ms (min %.2f, max %.2f), %.2f Mrays/s; %zu %s\n",
-                    limit.threads(), repeat, median, sorted.front(), sorted.back(), mrays, hit_count,
+        std::printf("  packets of %d, %d threads, %d passes: median %.2f ms (min %.2f, max %.2f), %.2f Mrays/s; %zu %s\n",
+                    packet, limit.threads(), repeat, median, sorted.front(), sorted.back(), mrays, hit_count,
                     file.kind == RayKind::ClosestHit ? "hits" : "occluded");
     }
     return 0;

@@ -1,11 +1,13 @@
 #include "render/whitted.h"
 
-#include <tbb/blocked_range2d.h>
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include "render/camera_rays.h"
 #include "render/surface.h"
@@ -27,7 +29,11 @@ public:
     }
 
     Vec3f trace(const Rayf& ray, int depth, RenderStats& stats) const {
-        const Hitf hit = accel_.intersect1(ray);
+        return shade_hit(ray, accel_.intersect1(ray), depth, stats);
+    }
+
+    /// Colour along `ray` whose closest hit is already known.
+    Vec3f shade_hit(const Rayf& ray, const Hitf& hit, int depth, RenderStats& stats) const {
         if (depth == 1) {
             ++stats.eye_rays;
             stats.eye_hits += hit.found();
@@ -130,21 +136,38 @@ RenderStats render_whitted(const Scene& scene, const Accel& accel, const Whitted
     const CameraFrame frame = make_camera_frame(scene.camera, options.width, options.height);
     const WhittedTracer tracer(scene, accel, options);
     std::atomic<std::uint64_t> eye{0}, eye_hits{0}, reflect{0}, refract{0}, shadow{0};
-    const int tile = std::max(options.tile_size, 1);
-    tbb::parallel_for(tbb::blocked_range2d<int>(0, options.height, tile, 0, options.width, tile),
-                      [&](const tbb::blocked_range2d<int>& r) {
-                          RenderStats local;
-                          for (int y = r.rows().begin(); y < r.rows().end(); ++y)
-                              for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
-                                  const Rayf ray = camera_ray(frame, float(x) + 0.5f, float(y) + 0.5f);
-                                  image.set(x, y, tracer.trace(ray, 1, local));
-                              }
-                          add(eye, local.eye_rays);
-                          add(eye_hits, local.eye_hits);
-                          add(reflect, local.reflect_rays);
-                          add(refract, local.refract_rays);
-                          add(shadow, local.shadow_rays);
-                      });
+    // Tiles of 16 x 16 pixels whose camera rays are ordered in 4 x 4 blocks,
+    // so that each packet of up to 16 consecutive rays covers a compact
+    // patch of the image.
+    constexpr int kTile = 16, kBlock = 4;
+    const int tiles_x = (options.width + kTile - 1) / kTile, tiles_y = (options.height + kTile - 1) / kTile;
+    tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y), [&](const tbb::blocked_range<int>& r) {
+        RenderStats local;
+        std::vector<Rayf> rays;
+        std::vector<Hitf> hits;
+        std::vector<std::pair<int, int>> pixels;
+        for (int tile = r.begin(); tile < r.end(); ++tile) {
+            const int x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
+            rays.clear();
+            pixels.clear();
+            for (int by = y0; by < std::min(y0 + kTile, options.height); by += kBlock)
+                for (int bx = x0; bx < std::min(x0 + kTile, options.width); bx += kBlock)
+                    for (int y = by; y < std::min(by + kBlock, options.height); ++y)
+                        for (int x = bx; x < std::min(bx + kBlock, options.width); ++x) {
+                            rays.push_back(camera_ray(frame, float(x) + 0.5f, float(y) + 0.5f));
+                            pixels.emplace_back(x, y);
+                        }
+            hits.resize(rays.size());
+            accel.intersect_packets(options.packet, rays, hits);
+            for (std::size_t i = 0; i < rays.size(); ++i)
+                image.set(pixels[i].first, pixels[i].second, tracer.shade_hit(rays[i], hits[i], 1, local));
+        }
+        add(eye, local.eye_rays);
+        add(eye_hits, local.eye_hits);
+        add(reflect, local.reflect_rays);
+        add(refract, local.refract_rays);
+        add(shadow, local.shadow_rays);
+    });
     RenderStats stats;
     stats.eye_rays = eye;
     stats.eye_hits = eye_hits;

@@ -19,6 +19,9 @@ struct WhittedOptions {
     /// larger of the hit point's magnitude and 1e-3 of the scene's extent.
     float offset_scale = 1e-4f;
     int tile_size = 16;
+    /// Primary rays are traced as packets of this width (1, 4, 8, 16), each
+    /// covering a compact block of pixels; secondary rays go one by one.
+    int packet = 1;
 };
 
 /// Ray counts in the SPD Readme's terms, to compare with its statistics table.
