@@ -109,7 +109,9 @@ RAYPACK_INLINE xsimd::batch<float, A> vmin(const xsimd::batch<float, A>& a, cons
     else if constexpr (sizeof(a) == 32) return _mm256_min_ps(a, b);
 #endif
 #if defined(__AVX512F__)
-    else if constexpr (sizeof(a) == 64) return _mm512_min_ps(a, b);
+    // Zero-masked with a full mask: the same vminps, without the undefined
+    // pass-through operand that makes gcc 12 warn (-Wmaybe-uninitialized).
+    else if constexpr (sizeof(a) == 64) return _mm512_maskz_min_ps(__mmask16(0xFFFF), a, b);
 #endif
     else static_assert(sizeof(A) == 0, "vmin: unsupported width");
 }
@@ -120,7 +122,7 @@ RAYPACK_INLINE xsimd::batch<float, A> vmax(const xsimd::batch<float, A>& a, cons
     else if constexpr (sizeof(a) == 32) return _mm256_max_ps(a, b);
 #endif
 #if defined(__AVX512F__)
-    else if constexpr (sizeof(a) == 64) return _mm512_max_ps(a, b);
+    else if constexpr (sizeof(a) == 64) return _mm512_maskz_max_ps(__mmask16(0xFFFF), a, b);
 #endif
     else static_assert(sizeof(A) == 0, "vmax: unsupported width");
 }
