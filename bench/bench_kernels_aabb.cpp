@@ -48,7 +48,7 @@ void aabb_packet(benchmark::State& state) {
     if (!validated(state, same && hits > 0 && hits < rays.n, "packet lanes differ from the scalar slab test")) return;
     for (auto _ : state) {
         std::uint32_t count = 0;
-        for (std::size_t i = 0; i < rays.n; i += K) count += std::popcount(box_hits<M, F>(packets[i / K], lo, hi));
+        for (const SlabRay<F>& packet : packets) count += std::popcount(box_hits<M, F>(packet, lo, hi));
         benchmark::DoNotOptimize(count);
     }
     set_tests_per_second(state, double(rays.n));
@@ -92,7 +92,7 @@ void aabb_1xM(benchmark::State& state) {
     if (!validated(state, same && hits > 0 && hits < rays.n * Width, "block lanes differ from the scalar slab test")) return;
     for (auto _ : state) {
         std::uint32_t count = 0;
-        for (std::size_t i = 0; i < rays.n; ++i) count += std::popcount(box_hits<M, F>(broadcast[i], lo, hi));
+        for (const SlabRay<F>& ray : broadcast) count += std::popcount(box_hits<M, F>(ray, lo, hi));
         benchmark::DoNotOptimize(count);
     }
     set_tests_per_second(state, double(rays.n) * Width);

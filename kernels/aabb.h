@@ -93,9 +93,9 @@ RAYPACK_INLINE mask_of<F> intersect_box(const mask_of<F>& valid, const SlabRay<F
     F tx0, tx1, ty0, ty1, tz0, tz1;
     mask_of<F> ok = valid;
     if constexpr (Method == SlabMethod::Plain) {
-        tx0 = vfmadd(lo.x, rdir.x, -ray.org_rdir.x), tx1 = vfmadd(hi.x, rdir.x, -ray.org_rdir.x);
-        ty0 = vfmadd(lo.y, rdir.y, -ray.org_rdir.y), ty1 = vfmadd(hi.y, rdir.y, -ray.org_rdir.y);
-        tz0 = vfmadd(lo.z, rdir.z, -ray.org_rdir.z), tz1 = vfmadd(hi.z, rdir.z, -ray.org_rdir.z);
+        tx0 = vfmsub(lo.x, rdir.x, ray.org_rdir.x), tx1 = vfmsub(hi.x, rdir.x, ray.org_rdir.x);
+        ty0 = vfmsub(lo.y, rdir.y, ray.org_rdir.y), ty1 = vfmsub(hi.y, rdir.y, ray.org_rdir.y);
+        tz0 = vfmsub(lo.z, rdir.z, ray.org_rdir.z), tz1 = vfmsub(hi.z, rdir.z, ray.org_rdir.z);
     } else {
         tx0 = (lo.x - org.x) * rdir.x, tx1 = (hi.x - org.x) * rdir.x;
         ty0 = (lo.y - org.y) * rdir.y, ty1 = (hi.y - org.y) * rdir.y;

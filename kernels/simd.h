@@ -145,6 +145,22 @@ RAYPACK_INLINE xsimd::batch<float, A> vfmadd(const xsimd::batch<float, A>& a, co
 }
 #endif
 
+/// Fused a * b - c with one rounding (vfmsub; no negation of c).
+RAYPACK_INLINE float vfmsub(float a, float b, float c) { return std::fma(a, b, -c); }
+RAYPACK_INLINE double vfmsub(double a, double b, double c) { return std::fma(a, b, -c); }
+#if defined(__FMA__)
+template <class A>
+RAYPACK_INLINE xsimd::batch<float, A> vfmsub(const xsimd::batch<float, A>& a, const xsimd::batch<float, A>& b,
+                                             const xsimd::batch<float, A>& c) {
+    if constexpr (sizeof(a) == 16) return _mm_fmsub_ps(a, b, c);
+    else if constexpr (sizeof(a) == 32) return _mm256_fmsub_ps(a, b, c);
+#if defined(__AVX512F__)
+    else if constexpr (sizeof(a) == 64) return _mm512_fmsub_ps(a, b, c);
+#endif
+    else static_assert(sizeof(A) == 0, "vfmsub: unsupported width");
+}
+#endif
+
 RAYPACK_INLINE float vsqrt(float x) { return std::sqrt(x); }
 RAYPACK_INLINE double vsqrt(double x) { return std::sqrt(x); }
 template <class A> RAYPACK_INLINE xsimd::batch<float, A> vsqrt(const xsimd::batch<float, A>& x) { return xsimd::sqrt(x); }
