@@ -1,0 +1,63 @@
+#pragma once
+// A uniform grid: the scene box cut into res.x * res.y * res.z equal cells,
+// each cell a range of one array of primitive references (the compact layout
+// of Lagae & Dutre, "Compact, Fast and Robust Grids for Ray Tracing", EGSR
+// 2008: cell c holds refs[cell_begin[c] .. cell_begin[c + 1]]).
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "kernels/aabb.h"
+
+namespace raypack {
+
+struct GridConfig {
+    /// Cells per primitive, the density lambda of the usual heuristic: about
+    /// lambda * N cells (Cleary & Wyvill, "Analysis of an algorithm for fast
+    /// ray tracing using uniform space subdivision", TVC 1988; lambda between
+    /// 1 and 8 in Ize et al., "Grid Creation Strategies for Efficient Ray
+    /// Tracing", RT 2007; 4 chosen from raypack's own sweep, see README).
+    float lambda = 4.0f;
+    /// Upper bounds that keep absurd inputs from exhausting memory: the cell
+    /// count (64M cells = 256 MiB of ranges), and the reference count (the
+    /// resolution is halved per axis until the references fit).
+    std::size_t max_cells = std::size_t(1) << 26;
+    std::size_t max_references = std::size_t(1) << 28;
+    /// Place triangles by exact triangle-box overlap and spheres by their
+    /// distance to the cell; false places every primitive by its box only.
+    bool exact_overlap = true;
+};
+
+/// What the 3D-DDA needs: the grid's box, resolution and cell size.
+struct GridGeometry {
+    Box3f bounds;
+    std::array<int, 3> res{0, 0, 0};
+    Vec3f cell_size;
+    Vec3f inv_cell_size;  ///< res / extent, maps a coordinate to a cell
+
+    std::size_t cells() const { return std::size_t(res[0]) * std::size_t(res[1]) * std::size_t(res[2]); }
+    std::uint32_t cell_index(int x, int y, int z) const {
+        return std::uint32_t(x) + std::uint32_t(res[0]) * (std::uint32_t(y) + std::uint32_t(res[1]) * std::uint32_t(z));
+    }
+    /// Coordinate of the plane between cells i - 1 and i along `axis`.
+    float plane(int axis, int i) const { return bounds.lo[axis] + float(i) * cell_size[axis]; }
+};
+
+struct Grid {
+    GridGeometry geometry;
+    std::vector<std::uint32_t> cell_begin;  ///< cells() + 1 offsets into refs
+    std::vector<std::uint32_t> refs;        ///< primitive numbers, sorted within each cell
+    float lambda = 0;                       ///< the density actually used (lowered if references overflowed)
+
+    bool empty() const { return refs.empty(); }
+    std::size_t bytes() const { return (cell_begin.size() + refs.size()) * sizeof(std::uint32_t); }
+};
+
+/// Resolution for `n` primitives in a box of extent `e`: about lambda * n
+/// near-cubic cells. Axes too thin for one cell get one cell and drop out of
+/// the density (a flat scene is gridded by area, a line by length); each
+/// axis has at least one cell and the total is at most max_cells.
+std::array<int, 3> grid_resolution(const Vec3f& extent, std::size_t n, float lambda, std::size_t max_cells);
+
+}  // namespace raypack

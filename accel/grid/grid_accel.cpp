@@ -1,0 +1,107 @@
+#include "accel/grid/grid_accel.h"
+
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+#include <vector>
+
+#include "accel/grid/dda.h"
+#include "accel/grid/grid_build.h"
+
+namespace raypack {
+
+GridAccel::GridAccel(const Scene& scene, const AccelConfig& config, const GridConfig& grid_config)
+    : scene_(&scene), kernels_(config.kernels) {
+    const auto start = std::chrono::steady_clock::now();
+    const std::size_t n = scene.primitive_count();
+    std::vector<Box3f> boxes(n);
+    tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) { boxes[i] = primitive_bounds(scene, std::uint32_t(i)); });
+    const PrimitiveBoxOverlap exact{&scene};
+    grid_ = build_grid(boxes, grid_config.exact_overlap ? &exact : nullptr, grid_config);
+    const auto stop = std::chrono::steady_clock::now();
+    for (std::size_t c = 0; c < grid_.geometry.cells(); ++c) empty_cells_ += grid_.cell_begin[c] == grid_.cell_begin[c + 1];
+    stats_.name = "grid";
+    stats_.builder = "uniform";
+    stats_.build_ms = std::chrono::duration<double, std::milli>(stop - start).count();
+    stats_.nodes = grid_.geometry.cells();
+    stats_.leaves = grid_.geometry.cells() - empty_cells_;
+    stats_.bytes = grid_.bytes();
+    stats_.depth = 1;
+}
+
+double GridAccel::references_per_primitive() const {
+    const std::size_t n = scene_->primitive_count();
+    return n ? double(grid_.refs.size()) / double(n) : 0.0;
+}
+
+double GridAccel::empty_cell_fraction() const {
+    const std::size_t cells = grid_.geometry.cells();
+    return cells ? double(empty_cells_) / double(cells) : 0.0;
+}
+
+// Walk the cells front to back and test every primitive in each. Any hit the
+// kernels report is a genuine hit in [tnear, tfar] and shrinks tfar, even if
+// it lies beyond the current cell (a primitive spanning cells); the walk
+// stops once the current cell ends past tfar, since no later cell can then
+// hold a nearer hit (pbrt-v1 GridAccel). No mailbox: re-testing a primitive
+// in a later cell gives the same answer, so it costs time, not correctness.
+template <bool AnyHit, bool Counting>
+bool GridAccel::trace(Rayf& ray, Hitf& hit, GridRayCounters* counters) const {
+    if constexpr (Counting) ++counters->rays;
+    if (grid_.empty()) return false;
+    const Vec3f inv_dir = reciprocal(ray.dir);
+    float entry;
+    if (!intersect_aabb(ray.org, inv_dir, grid_.geometry.bounds, ray.tnear, ray.tfar, entry)) return false;
+    const PrimitiveIntersector<float> isect{scene_, kernels_};
+    const std::uint32_t* begin = grid_.cell_begin.data();
+    const std::uint32_t* refs = grid_.refs.data();
+    GridDda dda(grid_.geometry, ray.org, ray.dir, inv_dir, entry);
+    bool found = false;
+    while (const std::optional<DdaSegment> seg = dda.next()) {
+        const std::uint32_t first = begin[seg->cell], last = begin[seg->cell + 1];
+        if constexpr (Counting) {
+            ++counters->cells_visited;
+            counters->prim_tests += last - first;
+        }
+        for (std::uint32_t k = first; k < last; ++k) {
+            if (isect.intersect(refs[k], ray, hit)) {
+                found = true;
+                if constexpr (AnyHit) return true;
+            }
+        }
+        if (seg->t_exit > ray.tfar) break;
+    }
+    return found;
+}
+
+void GridAccel::intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const {
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        Rayf ray = rays[i];
+        Hitf hit;
+        trace<false, false>(ray, hit, nullptr);
+        hits[i] = hit;
+    }
+}
+
+void GridAccel::occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const {
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        Rayf ray = rays[i];
+        Hitf hit;
+        occluded[i] = trace<true, false>(ray, hit, nullptr) ? 1 : 0;
+    }
+}
+
+Hitf GridAccel::intersect_counting(const Rayf& ray_in, GridRayCounters& counters) const {
+    Rayf ray = ray_in;
+    Hitf hit;
+    trace<false, true>(ray, hit, &counters);
+    return hit;
+}
+
+bool GridAccel::occluded_counting(const Rayf& ray_in, GridRayCounters& counters) const {
+    Rayf ray = ray_in;
+    Hitf hit;
+    return trace<true, true>(ray, hit, &counters);
+}
+
+}  // namespace raypack

@@ -1,0 +1,52 @@
+#pragma once
+// Uniform grid traversed by a 3D-DDA, single ray.
+#include <array>
+#include <cstdint>
+
+#include "accel/accel.h"
+#include "accel/grid/grid.h"
+
+namespace raypack {
+
+/// Per-ray work, gathered by the counting traversal only.
+struct GridRayCounters {
+    std::uint64_t rays = 0;
+    std::uint64_t cells_visited = 0;  ///< cells the DDA yielded, empty ones included
+    std::uint64_t prim_tests = 0;     ///< ray-primitive tests, repeats in later cells included
+};
+
+class GridAccel final : public Accel {
+public:
+    GridAccel(const Scene& scene, const AccelConfig& config, const GridConfig& grid_config = {});
+    void intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const override;
+    void occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override;
+    const AccelStats& stats() const override { return stats_; }
+
+    /// The same queries, adding each ray's work to `counters` (slower; tests and analysis).
+    Hitf intersect_counting(const Rayf& ray, GridRayCounters& counters) const;
+    bool occluded_counting(const Rayf& ray, GridRayCounters& counters) const;
+
+    const Grid& grid() const { return grid_; }
+    std::array<int, 3> resolution() const { return grid_.geometry.res; }
+    std::size_t cell_count() const { return grid_.geometry.cells(); }
+    std::size_t reference_count() const { return grid_.refs.size(); }
+    /// Cells per primitive actually used (below GridConfig::lambda only if
+    /// the reference cap forced coarser cells).
+    float lambda() const { return grid_.lambda; }
+    /// References per primitive: how often the average primitive is stored.
+    double references_per_primitive() const;
+    double empty_cell_fraction() const;
+    std::size_t empty_cells() const { return empty_cells_; }
+
+private:
+    template <bool AnyHit, bool Counting>
+    bool trace(Rayf& ray, Hitf& hit, GridRayCounters* counters) const;
+
+    const Scene* scene_;
+    KernelChoice kernels_;
+    Grid grid_;
+    std::size_t empty_cells_ = 0;
+    AccelStats stats_;
+};
+
+}  // namespace raypack

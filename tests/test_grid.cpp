@@ -1,0 +1,853 @@
+// The uniform grid (accel/grid/) against the brute-force oracle, and its
+// parts against brute-force references: the triangle-box overlap test
+// against clipping, the placement of primitives against clipping per cell,
+// the 3D-DDA against slab tests of every cell, the resolution heuristic.
+// The grid runs the very same primitive kernels as the oracle, so it must
+// agree exactly: the same hit or miss on every ray, bit-identical t for the
+// same primitive, another primitive only at a shared edge or vertex, and the
+// same occlusion answers.
+#include <gtest/gtest.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <functional>
+#include <iomanip>
+#include <limits>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "accel/accel.h"
+#include "accel/brute/brute_force.h"
+#include "accel/grid/dda.h"
+#include "accel/grid/grid_accel.h"
+#include "accel/grid/grid_build.h"
+#include "accel/grid/triangle_box_overlap.h"
+#include "render/camera_rays.h"
+#include "scene/load.h"
+
+namespace raypack::grid_test {
+namespace {
+
+// ---- Tracing and comparing --------------------------------------------------------
+
+std::string describe(const Rayf& r) {
+    std::ostringstream os;
+    os << std::hexfloat << "org (" << r.org.x << ", " << r.org.y << ", " << r.org.z << ") dir (" << r.dir.x << ", "
+       << r.dir.y << ", " << r.dir.z << ") tnear " << r.tnear << " tfar " << r.tfar << std::defaultfloat << " ["
+       << r.org.x << ", " << r.org.y << ", " << r.org.z << " / " << r.dir.x << ", " << r.dir.y << ", " << r.dir.z
+       << "]";
+    return os.str();
+}
+
+std::string describe(const Hitf& h) {
+    if (!h.found()) return "miss";
+    std::ostringstream os;
+    os << "prim " << h.prim << " t " << std::setprecision(9) << h.t;
+    return os.str();
+}
+
+std::vector<Hitf> trace(const Accel& accel, const std::vector<Rayf>& rays) {
+    std::vector<Hitf> hits(rays.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 64), [&](const auto& r) {
+        accel.intersect(std::span<const Rayf>(rays).subspan(r.begin(), r.size()),
+                        std::span<Hitf>(hits).subspan(r.begin(), r.size()));
+    });
+    return hits;
+}
+
+std::vector<std::uint8_t> trace_occluded(const Accel& accel, const std::vector<Rayf>& rays) {
+    std::vector<std::uint8_t> occ(rays.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 64), [&](const auto& r) {
+        accel.occluded(std::span<const Rayf>(rays).subspan(r.begin(), r.size()),
+                       std::span<std::uint8_t>(occ).subspan(r.begin(), r.size()));
+    });
+    return occ;
+}
+
+/// Closest hits that agree exactly: same hit or miss; the same primitive at
+/// the bit-identical t; another primitive only at a t within 1e-5 (a shared
+/// edge or vertex, where either is right).
+std::string hit_mismatches(const std::vector<Rayf>& rays, const std::vector<Hitf>& want, const std::vector<Hitf>& got,
+                           std::size_t& count) {
+    std::string first;
+    count = 0;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        bool ok = want[i].found() == got[i].found();
+        if (ok && want[i].found()) {
+            ok = want[i].prim == got[i].prim
+                     ? want[i].t == got[i].t
+                     : std::fabs(want[i].t - got[i].t) <= 1e-5f * std::max(std::fabs(want[i].t), std::fabs(got[i].t));
+        }
+        if (ok) continue;
+        if (++count <= 5)
+            first += "\n  ray " + std::to_string(i) + ": " + describe(rays[i]) + "\n    brute " + describe(want[i]) +
+                     ", grid " + describe(got[i]);
+    }
+    return first;
+}
+
+std::string occlusion_mismatches(const std::vector<Rayf>& rays, const std::vector<std::uint8_t>& want,
+                                 const std::vector<std::uint8_t>& got, std::size_t& count) {
+    std::string first;
+    count = 0;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        if (want[i] == got[i]) continue;
+        if (++count <= 5)
+            first += "\n  ray " + std::to_string(i) + ": " + describe(rays[i]) + "\n    brute " +
+                     (want[i] ? "occluded" : "clear") + ", grid " + (got[i] ? "occluded" : "clear");
+    }
+    return first;
+}
+
+/// Closest hit and occlusion of every ray, grid against brute force.
+void expect_agreement(const Scene& scene, const Accel& grid, const std::vector<Rayf>& rays, const std::string& what) {
+    const BruteForce brute(scene, KernelChoice{});
+    const std::vector<Hitf> truth = trace(brute, rays);
+    std::size_t n = 0;
+    const std::string hits = hit_mismatches(rays, truth, trace(grid, rays), n);
+    EXPECT_EQ(n, 0u) << what << ": " << n << " of " << rays.size() << " closest hits differ" << hits;
+    // Brute force finds a closest hit iff some primitive is hit within the
+    // ray's original [tnear, tfar], which is its occlusion answer.
+    std::vector<std::uint8_t> occluded(rays.size());
+    for (std::size_t i = 0; i < rays.size(); ++i) occluded[i] = truth[i].found() ? 1 : 0;
+    const std::string occ = occlusion_mismatches(rays, occluded, trace_occluded(grid, rays), n);
+    EXPECT_EQ(n, 0u) << what << ": " << n << " of " << rays.size() << " occlusion answers differ" << occ;
+}
+
+// ---- Ray sets -----------------------------------------------------------------------
+
+std::vector<Rayf> camera_rays(const Scene& scene, int size) {
+    const CameraFrame f = make_camera_frame(scene.camera, size, size);
+    std::vector<Rayf> rays;
+    for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x) rays.push_back(camera_ray(f, float(x) + 0.5f, float(y) + 0.5f));
+    return rays;
+}
+
+Vec3f random_direction(std::mt19937& rng) {
+    std::normal_distribution<float> n;
+    for (;;) {
+        const Vec3f d{n(rng), n(rng), n(rng)};
+        if (dot(d, d) > 1e-6f) return normalize(d);
+    }
+}
+
+Vec3f random_point(std::mt19937& rng, const Box3f& box) {
+    std::uniform_real_distribution<float> u(0, 1);
+    const Vec3f e = box.extent();
+    return {box.lo.x + u(rng) * e.x, box.lo.y + u(rng) * e.y, box.lo.z + u(rng) * e.z};
+}
+
+float signed_zero(std::mt19937& rng) { return rng() % 2 ? 0.0f : -0.0f; }
+
+Box3f grown(Box3f b, float f) {
+    const Vec3f e = b.extent() * f;
+    b.lo -= e;
+    b.hi += e;
+    return b;
+}
+
+std::vector<Rayf> random_rays(const Scene& scene, std::mt19937& rng, int n) {
+    const Box3f box = scene_bounds(scene);
+    const float diag = length(box.extent());
+    std::uniform_real_distribution<float> u(0, 1);
+    std::vector<Rayf> rays(n);
+    for (int i = 0; i < n; ++i) {
+        rays[i].org = random_point(rng, grown(box, 0.2f));
+        rays[i].dir = random_direction(rng);
+        if (i % 2) rays[i].tfar = u(rng) * diag;
+    }
+    return rays;
+}
+
+/// Rays that make a 3D-DDA stumble, built from the grid's own planes.
+std::vector<Rayf> grid_adversarial_rays(const GridGeometry& g, const Scene& scene, std::mt19937& rng) {
+    std::vector<Rayf> rays;
+    const Box3f box = g.bounds;
+    const float diag = length(box.extent());
+    std::uniform_real_distribution<float> u(0, 1);
+    auto plane = [&](int axis) { return g.plane(axis, int(rng() % std::uint32_t(g.res[axis] + 1))); };
+    auto corner = [&] { return Vec3f{plane(0), plane(1), plane(2)}; };
+    auto axis_dir = [&](int axis, float sign) {
+        Vec3f d{signed_zero(rng), signed_zero(rng), signed_zero(rng)};
+        d[axis] = sign;
+        return d;
+    };
+    // 1. Along cell edges: the two other coordinates exactly on cell planes,
+    //    axis-parallel, from outside the grid.
+    for (int i = 0; i < 600; ++i) {
+        const int a = i % 3;
+        const float sign = (i / 3) % 2 ? 1.0f : -1.0f;
+        Rayf r;
+        r.org = corner();
+        r.org[a] = sign > 0 ? box.lo[a] - 0.1f * diag : box.hi[a] + 0.1f * diag;
+        r.dir = axis_dir(a, sign);
+        rays.push_back(r);
+    }
+    // 2. Inside a cell plane (that direction component +-0), from inside the grid.
+    for (int i = 0; i < 600; ++i) {
+        const int a = i % 3;
+        Rayf r;
+        r.org = random_point(rng, box);
+        r.org[a] = plane(a);
+        r.dir = random_direction(rng);
+        r.dir[a] = signed_zero(rng);
+        rays.push_back(r);
+    }
+    // 3. Axis-parallel from random origins in and around the grid; half with a finite tfar.
+    for (int i = 0; i < 600; ++i) {
+        Rayf r;
+        r.org = random_point(rng, grown(box, 0.1f));
+        r.dir = axis_dir(i % 3, (i / 3) % 2 ? 1.0f : -1.0f);
+        if (i % 2) r.tfar = u(rng) * diag;
+        rays.push_back(r);
+    }
+    // 4. Starting inside cells, some from tnear > 0 (the walk begins mid-grid).
+    for (int i = 0; i < 600; ++i) {
+        Rayf r;
+        r.org = random_point(rng, box);
+        r.dir = random_direction(rng);
+        if (i % 2) r.tnear = u(rng) * 0.5f * diag;
+        if (i % 3 == 0) r.tfar = r.tnear + u(rng) * 0.5f * diag;
+        rays.push_back(r);
+    }
+    // 5. Through cell corners, and from cell corners.
+    for (int i = 0; i < 900; ++i) {
+        Rayf r;
+        const Vec3f c = corner();
+        if (i % 3 == 0) {
+            r.org = c;
+            r.dir = random_direction(rng);
+        } else {
+            r.org = random_point(rng, grown(box, 0.5f));
+            r.dir = c - r.org;
+            if (!(dot(r.dir, r.dir) > 0)) r.dir = {1, 1, 1};
+        }
+        rays.push_back(r);
+    }
+    // 6. Along cell diagonals: ties between all three axes at every step.
+    for (int i = 0; i < 300; ++i) {
+        Rayf r;
+        Vec3f d = g.cell_size;
+        for (int a = 0; a < 3; ++a)
+            if (rng() % 2) d[a] = -d[a];
+        r.org = corner() - d * float(1 + rng() % 4);
+        r.dir = d;
+        rays.push_back(r);
+    }
+    // 7. From far away (10 grid diagonals), aimed into the grid.
+    for (int i = 0; i < 300; ++i) {
+        Rayf r;
+        const Vec3f target = random_point(rng, box);
+        r.org = target - random_direction(rng) * (10.0f * diag);
+        r.dir = target - r.org;
+        rays.push_back(r);
+    }
+    // 8. On the grid's faces, the far ones included: inwards and along the face.
+    for (int i = 0; i < 300; ++i) {
+        const int a = i % 3;
+        const bool hi = (i / 3) % 2;
+        Rayf r;
+        r.org = random_point(rng, box);
+        r.org[a] = hi ? box.hi[a] : box.lo[a];
+        r.dir = random_direction(rng);
+        r.dir[a] = i % 4 == 0 ? signed_zero(rng) : (hi ? -1.0f : 1.0f) * std::fabs(r.dir[a]);
+        rays.push_back(r);
+    }
+    // 9. Aimed at triangle vertices and sphere poles, which lie on cell planes only by chance.
+    const auto nprims = std::uint32_t(scene.primitive_count());
+    for (int i = 0; i < 300; ++i) {
+        const PrimRef ref = scene.prims[rng() % nprims];
+        Vec3f target;
+        if (ref.kind == PrimKind::Triangle) {
+            target = scene.triangles.p0[ref.index];
+        } else if (ref.kind == PrimKind::Sphere) {
+            target = scene.spheres.center[ref.index];
+            target[int(rng() % 3)] += scene.spheres.radius[ref.index];
+        } else {
+            target = scene.cones.apex[ref.index];
+        }
+        Rayf r;
+        r.org = random_point(rng, grown(box, 0.2f));
+        r.dir = target - r.org;
+        if (!(dot(r.dir, r.dir) > 0)) r.dir = {0, 0, 1};
+        rays.push_back(r);
+    }
+    return rays;
+}
+
+std::vector<Rayf> shadow_rays(const Scene& scene, const std::vector<Rayf>& rays, const std::vector<Hitf>& hits) {
+    std::vector<Rayf> out;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        if (!hits[i].found()) continue;
+        const Vec3f p = rays[i].org + rays[i].dir * hits[i].t;
+        for (const PointLight& light : scene.lights) {
+            Rayf s;
+            s.org = p;
+            s.dir = light.position - p;
+            s.tnear = 1e-4f;
+            s.tfar = 1.0f - 1e-4f;
+            out.push_back(s);
+        }
+    }
+    return out;
+}
+
+std::unique_ptr<GridAccel> make_grid(const Scene& scene, const GridConfig& gc = {}) {
+    return std::make_unique<GridAccel>(scene, AccelConfig{}, gc);
+}
+
+// ---- Every shared scene -------------------------------------------------------------
+
+std::vector<std::string> scene_files() {
+    std::vector<std::string> files;
+    for (const auto& e : std::filesystem::directory_iterator(std::string(RAYPACK_SOURCE_DIR) + "/scenes"))
+        if (e.path().extension() == ".nff") files.push_back(e.path().filename().string());
+    std::sort(files.begin(), files.end());
+    files.push_back("bunny.obj");
+    return files;
+}
+
+// One fixture for the whole suite, so that every test is called Grid.*.
+class Grid : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(Grid, MatchesBruteForce) {
+    const Scene scene = load_scene(std::string(RAYPACK_SOURCE_DIR) + "/scenes/" + GetParam());
+    AccelConfig config;
+    config.kind = "grid";
+    const std::unique_ptr<Accel> accel = build_accel(scene, config);
+    const auto& grid = dynamic_cast<const GridAccel&>(*accel);
+    std::mt19937 rng(20240605);
+    const BruteForce brute(scene, KernelChoice{});
+
+    const std::vector<Rayf> camera = camera_rays(scene, 64);
+    expect_agreement(scene, grid, camera, GetParam() + " camera");
+    expect_agreement(scene, grid, random_rays(scene, rng, 2000), GetParam() + " random");
+    expect_agreement(scene, grid, grid_adversarial_rays(grid.grid().geometry, scene, rng), GetParam() + " adversarial");
+    const std::vector<Rayf> shadows = shadow_rays(scene, camera, trace(brute, camera));
+    std::size_t n = 0;
+    const std::string occ = occlusion_mismatches(shadows, trace_occluded(brute, shadows), trace_occluded(grid, shadows), n);
+    EXPECT_EQ(n, 0u) << GetParam() << " shadow: " << n << " of " << shadows.size() << " occlusion answers differ" << occ;
+
+    // The statistics describe what was built.
+    const AccelStats& s = grid.stats();
+    EXPECT_EQ(s.name, "grid");
+    EXPECT_EQ(s.builder, "uniform");
+    EXPECT_EQ(s.nodes, grid.cell_count());
+    std::size_t nonempty = 0;
+    for (std::size_t c = 0; c < grid.cell_count(); ++c)
+        nonempty += grid.grid().cell_begin[c + 1] > grid.grid().cell_begin[c];
+    EXPECT_EQ(s.leaves, nonempty);
+    EXPECT_DOUBLE_EQ(grid.empty_cell_fraction(), 1.0 - double(nonempty) / double(grid.cell_count()));
+    EXPECT_EQ(s.bytes, (grid.cell_count() + 1 + grid.reference_count()) * sizeof(std::uint32_t));
+    EXPECT_GE(grid.references_per_primitive(), 1.0);
+    const double cells_per_prim = double(grid.cell_count()) / double(scene.primitive_count());
+    EXPECT_GT(cells_per_prim, 4.0 / 3.0) << "lambda 4";
+    EXPECT_LT(cells_per_prim, 4.0 * 3.0) << "lambda 4";
+    RecordProperty("cells", std::to_string(grid.cell_count()));
+    RecordProperty("refs_per_prim", std::to_string(grid.references_per_primitive()));
+}
+
+std::string param_name(const ::testing::TestParamInfo<std::string>& info) {
+    std::string s = info.param;
+    std::replace(s.begin(), s.end(), '.', '_');
+    return s;
+}
+
+INSTANTIATE_TEST_SUITE_P(, Grid, ::testing::ValuesIn(scene_files()), param_name);
+
+// ---- Hand-made scenes -----------------------------------------------------------------
+
+Scene scene_with(const std::function<void(Scene&)>& add) {
+    Scene s;
+    s.materials.push_back({});
+    add(s);
+    s.update_features();
+    return s;
+}
+
+TEST_F(Grid, RegisteredAsAnAccelKind) {
+    const auto kinds = accel_kinds();
+    EXPECT_NE(std::find_if(kinds.begin(), kinds.end(), [](const char* k) { return std::string(k) == "grid"; }),
+              kinds.end());
+    EXPECT_NE(accel_kinds_list().find("grid"), std::string::npos);
+}
+
+TEST_F(Grid, OnePrimitiveOfEachKind) {
+    const std::vector<Scene> scenes = {
+        scene_with([](Scene& s) { s.add_sphere({1, 2, 3}, 0.5f, 0); }),
+        scene_with([](Scene& s) { s.add_triangle({0, 0, 0}, {1, 0, 0}, {0, 1, 1}, 0); }),
+        scene_with([](Scene& s) { s.add_cone({0, 0, 0}, 0.5f, {0, 0, 2}, 0.1f, 0); }),
+    };
+    std::mt19937 rng(7);
+    for (const Scene& scene : scenes) {
+        const auto grid = make_grid(scene);
+        EXPECT_GE(grid->cell_count(), 1u);
+        for (int r : grid->resolution()) EXPECT_GE(r, 1);
+        std::vector<Rayf> rays = random_rays(scene, rng, 500);
+        const std::vector<Rayf> adv = grid_adversarial_rays(grid->grid().geometry, scene, rng);
+        rays.insert(rays.end(), adv.begin(), adv.end());
+        expect_agreement(scene, *grid, rays, "one " + std::to_string(int(scene.prims[0].kind)));
+    }
+}
+
+TEST_F(Grid, EmptySceneMissesEverything) {
+    const Scene scene;
+    const auto grid = make_grid(scene);
+    Rayf r;
+    r.dir = {1, 1, 1};
+    EXPECT_FALSE(grid->intersect1(r).found());
+    EXPECT_FALSE(grid->occluded1(r));
+    EXPECT_EQ(grid->cell_count(), 0u);
+}
+
+/// A triangulated square of n x n quads in the plane `axis` = 0.5, plus
+/// random triangles in the same plane.
+Scene flat_scene(int axis, int n, std::mt19937& rng) {
+    return scene_with([&](Scene& s) {
+        auto point = [&](float u, float v) {
+            Vec3f p;
+            p[axis] = 0.5f;
+            p[(axis + 1) % 3] = u;
+            p[(axis + 2) % 3] = v;
+            return p;
+        };
+        const float h = 1.0f / float(n);
+        for (int i = 0; i < n; ++i) {
+            for (int j = 0; j < n; ++j) {
+                const float u = float(i) * h, v = float(j) * h;
+                s.add_triangle(point(u, v), point(u + h, v), point(u + h, v + h), 0);
+                s.add_triangle(point(u, v), point(u + h, v + h), point(u, v + h), 0);
+            }
+        }
+        std::uniform_real_distribution<float> u(0, 1);
+        for (int i = 0; i < 100; ++i) s.add_triangle(point(u(rng), u(rng)), point(u(rng), u(rng)), point(u(rng), u(rng)), 0);
+    });
+}
+
+TEST_F(Grid, FlatScenes) {
+    std::mt19937 rng(11);
+    for (int axis = 0; axis < 3; ++axis) {
+        SCOPED_TRACE(axis);
+        const Scene scene = flat_scene(axis, 24, rng);
+        const auto grid = make_grid(scene);
+        // One layer of cells across the plane, about lambda * N over its area.
+        EXPECT_EQ(grid->resolution()[axis], 1);
+        const GridGeometry& g = grid->grid().geometry;
+        EXPECT_GT(g.bounds.hi[axis] - g.bounds.lo[axis], 0.1f * g.cell_size[(axis + 1) % 3]);
+        const double per_prim = double(grid->cell_count()) / double(scene.primitive_count());
+        EXPECT_GT(per_prim, 2.0);
+        EXPECT_LT(per_prim, 8.0);
+
+        std::vector<Rayf> rays = random_rays(scene, rng, 1000);
+        const std::vector<Rayf> adv = grid_adversarial_rays(g, scene, rng);
+        rays.insert(rays.end(), adv.begin(), adv.end());
+        std::uniform_real_distribution<float> u(0, 1);
+        for (int i = 0; i < 1000; ++i) {
+            Rayf r;
+            r.org[axis] = 0.5f;
+            r.org[(axis + 1) % 3] = u(rng) * 1.4f - 0.2f;
+            r.org[(axis + 2) % 3] = u(rng) * 1.4f - 0.2f;
+            r.dir = random_direction(rng);
+            if (i % 2) {
+                r.dir[axis] = signed_zero(rng);  // in the plane
+            } else {
+                r.org -= r.dir * (0.5f + u(rng));  // across the plane, starting off it
+            }
+            rays.push_back(r);
+        }
+        expect_agreement(scene, *grid, rays, "flat " + std::to_string(axis));
+    }
+}
+
+TEST_F(Grid, PrimitivesSpanningManyCells) {
+    std::mt19937 rng(13);
+    std::uniform_real_distribution<float> u(0, 1);
+    const Scene scene = scene_with([&](Scene& s) {
+        for (int i = 0; i < 2000; ++i) {
+            const Vec3f p{u(rng) * 10, u(rng) * 10, u(rng) * 10};
+            s.add_triangle(p, p + Vec3f{0.2f, 0, 0}, p + Vec3f{0, 0.2f, 0.1f}, 0);
+        }
+        // Huge triangles across the whole box, a big sphere and a long thin cone.
+        s.add_triangle({-1, -1, 5}, {11, -1, 5.5f}, {5, 11, 4}, 0);
+        s.add_triangle({0, 0, 0}, {10, 10, 10}, {10, 0, 10}, 0);
+        s.add_sphere({5, 5, 5}, 3, 0);
+        s.add_cone({0, 10, 0}, 0.3f, {10, 0, 10}, 0.3f, 0);
+    });
+    const auto grid = make_grid(scene);
+    // The big primitives are each in many cells.
+    std::vector<std::size_t> cells_of(scene.primitive_count(), 0);
+    for (std::uint32_t p : grid->grid().refs) ++cells_of[p];
+    for (std::uint32_t p = 2000; p < 2004; ++p) EXPECT_GT(cells_of[p], 50u) << p;
+    std::vector<Rayf> rays = random_rays(scene, rng, 3000);
+    const std::vector<Rayf> adv = grid_adversarial_rays(grid->grid().geometry, scene, rng);
+    rays.insert(rays.end(), adv.begin(), adv.end());
+    expect_agreement(scene, *grid, rays, "spanning");
+}
+
+TEST_F(Grid, ReferenceCapCoarsensTheGrid) {
+    // Big overlapping spheres: every sphere is in most cells at lambda 4.
+    std::mt19937 rng(17);
+    std::uniform_real_distribution<float> u(0, 1);
+    const Scene scene = scene_with([&](Scene& s) {
+        for (int i = 0; i < 300; ++i) s.add_sphere({u(rng), u(rng), u(rng)}, 0.8f, 0);
+    });
+    GridConfig gc;
+    gc.max_references = 20000;
+    const auto grid = make_grid(scene, gc);
+    EXPECT_LE(grid->reference_count(), gc.max_references);
+    EXPECT_LT(grid->lambda(), gc.lambda);
+    expect_agreement(scene, *grid, random_rays(scene, rng, 1000), "capped");
+    // An absurd density is held at max_cells.
+    gc = {};
+    gc.lambda = 1e9f;
+    gc.max_cells = 5000;
+    const auto dense = make_grid(scene, gc);
+    EXPECT_LE(dense->cell_count(), 5000u);
+    EXPECT_GT(dense->cell_count(), 2500u);
+}
+
+TEST_F(Grid, BuildIsDeterministic) {
+    const Scene scene = load_scene(std::string(RAYPACK_SOURCE_DIR) + "/scenes/tetra.nff");
+    const auto a = make_grid(scene), b = make_grid(scene);
+    EXPECT_EQ(a->grid().cell_begin, b->grid().cell_begin);
+    EXPECT_EQ(a->grid().refs, b->grid().refs);
+}
+
+TEST_F(Grid, CountingModeAgreesAndCounts) {
+    const Scene scene = load_scene(std::string(RAYPACK_SOURCE_DIR) + "/scenes/teapot.nff");
+    const auto grid = make_grid(scene);
+    const std::vector<Rayf> rays = camera_rays(scene, 32);
+    GridRayCounters c;
+    for (const Rayf& r : rays) {
+        const Hitf want = grid->intersect1(r);
+        const Hitf got = grid->intersect_counting(r, c);
+        EXPECT_EQ(want.prim, got.prim);
+        EXPECT_EQ(want.t, got.t);
+        EXPECT_EQ(grid->occluded1(r), grid->occluded_counting(r, c));
+    }
+    EXPECT_EQ(c.rays, 2 * rays.size());
+    EXPECT_GT(c.cells_visited, c.rays);
+    EXPECT_GT(c.prim_tests, 0u);
+
+    // A ray straight through an empty row of cells visits exactly res.x of them.
+    const Scene corners = scene_with([](Scene& s) {
+        s.add_sphere({0, 0, 0}, 0.01f, 0);
+        s.add_sphere({1, 1, 1}, 0.01f, 0);
+    });
+    GridConfig gc;
+    gc.lambda = 1000;
+    const auto sparse = make_grid(corners, gc);
+    const GridGeometry& g = sparse->grid().geometry;
+    ASSERT_GT(g.res[0], 5);
+    Rayf r;
+    r.org = {-1, 0.5f * (g.plane(1, 2) + g.plane(1, 3)), 0.5f * (g.plane(2, 2) + g.plane(2, 3))};
+    r.dir = {1, 0, 0};
+    GridRayCounters row;
+    EXPECT_FALSE(sparse->intersect_counting(r, row).found());
+    EXPECT_EQ(row.cells_visited, std::uint64_t(g.res[0]));
+    EXPECT_EQ(row.prim_tests, 0u);
+    // A ray that misses the grid visits none.
+    r.org = {-1, 5, 5};
+    GridRayCounters none;
+    EXPECT_FALSE(sparse->intersect_counting(r, none).found());
+    EXPECT_EQ(none.cells_visited, 0u);
+}
+
+// ---- The 3D-DDA against slab tests of every cell ---------------------------------------
+
+/// Double-precision slab test of a ray against a box: the parametric
+/// interval, empty when lo > hi.
+std::pair<double, double> slab_interval(const Rayf& r, const Vec3d& lo, const Vec3d& hi) {
+    double t0 = r.tnear, t1 = r.tfar;
+    for (int a = 0; a < 3; ++a) {
+        const double o = r.org[a], d = r.dir[a];
+        if (d == 0) {
+            if (o < lo[a] || o > hi[a]) return {1, 0};
+            continue;
+        }
+        double n = (lo[a] - o) / d, f = (hi[a] - o) / d;
+        if (n > f) std::swap(n, f);
+        t0 = std::max(t0, n);
+        t1 = std::min(t1, f);
+    }
+    return {t0, t1};
+}
+
+TEST_F(Grid, DdaVisitsEveryCellTheRayCrossesInOrder) {
+    GridGeometry g;
+    g.res = {7, 5, 9};
+    g.bounds.lo = {-1.5f, 0.25f, 2.0f};
+    g.bounds.hi = {2.0f, 3.0f, 6.5f};
+    for (int a = 0; a < 3; ++a) {
+        g.cell_size[a] = (g.bounds.hi[a] - g.bounds.lo[a]) / float(g.res[a]);
+        g.inv_cell_size[a] = float(g.res[a]) / (g.bounds.hi[a] - g.bounds.lo[a]);
+    }
+    std::mt19937 rng(19);
+    std::vector<Rayf> rays = grid_adversarial_rays(g, scene_with([](Scene& s) { s.add_sphere({0, 1, 3}, 0.1f, 0); }), rng);
+    for (int i = 0; i < 2000; ++i) {
+        Rayf r;
+        r.org = random_point(rng, grown(g.bounds, 0.3f));
+        r.dir = random_direction(rng);
+        rays.push_back(r);
+    }
+    std::size_t checked = 0;
+    for (const Rayf& r : rays) {
+        float entry;
+        if (!intersect_aabb(r.org, reciprocal(r.dir), g.bounds, r.tnear, r.tfar, entry)) continue;
+        std::vector<std::uint32_t> walk;
+        std::vector<DdaSegment> segs;
+        GridDda dda(g, r.org, r.dir, reciprocal(r.dir), entry);
+        while (const auto s = dda.next()) {
+            segs.push_back(*s);
+            walk.push_back(s->cell);
+            ASSERT_LT(walk.size(), 100u) << describe(r);
+        }
+        ASSERT_FALSE(segs.empty()) << describe(r);
+        // Consecutive segments join up, and t does not run backwards (up to rounding).
+        for (std::size_t k = 1; k < segs.size(); ++k) {
+            EXPECT_EQ(segs[k].t_enter, segs[k - 1].t_exit) << describe(r);
+            EXPECT_GE(segs[k].t_exit, segs[k].t_enter - 1e-5f * std::fabs(segs[k].t_enter)) << describe(r);
+        }
+        // Every cell the ray crosses by more than rounding is walked, and
+        // every walked cell is within rounding of the ray.
+        const double eps = 1e-3 * double(g.cell_size.x);
+        Rayf unbounded = r;
+        unbounded.tfar = std::numeric_limits<float>::infinity();  // the walk goes on past tfar
+        for (int z = 0; z < g.res[2]; ++z) {
+            for (int y = 0; y < g.res[1]; ++y) {
+                for (int x = 0; x < g.res[0]; ++x) {
+                    const Vec3d lo{g.plane(0, x), g.plane(1, y), g.plane(2, z)};
+                    const Vec3d hi{g.plane(0, x + 1), g.plane(1, y + 1), g.plane(2, z + 1)};
+                    const Vec3d e{eps, eps, eps};
+                    const auto inner = slab_interval(r, lo + e, hi - e);
+                    const auto outer = slab_interval(unbounded, lo - e, hi + e);
+                    const bool walked = std::find(walk.begin(), walk.end(), g.cell_index(x, y, z)) != walk.end();
+                    if (inner.first < inner.second) {
+                        EXPECT_TRUE(walked) << x << " " << y << " " << z << " " << describe(r);
+                    }
+                    if (walked) {
+                        EXPECT_LE(outer.first, outer.second) << x << " " << y << " " << z << " " << describe(r);
+                    }
+                }
+            }
+        }
+        ++checked;
+    }
+    EXPECT_GT(checked, 2000u);
+}
+
+// ---- Resolution heuristic -----------------------------------------------------------------
+
+TEST_F(Grid, ResolutionFollowsDensityAndShape) {
+    auto total = [](const std::array<int, 3>& r) { return std::size_t(r[0]) * r[1] * r[2]; };
+    // A cube: about lambda * N cubic cells.
+    std::array<int, 3> r = grid_resolution({2, 2, 2}, 1000, 4, 1 << 26);
+    EXPECT_EQ(r[0], r[1]);
+    EXPECT_EQ(r[1], r[2]);
+    EXPECT_NEAR(double(total(r)), 4000.0, 4000.0 * 0.2);
+    // A box 4:2:1: cells near-cubic, so resolution in the same ratio.
+    r = grid_resolution({4, 2, 1}, 1000, 4, 1 << 26);
+    EXPECT_NEAR(double(r[0]) / r[2], 4.0, 0.6);
+    EXPECT_NEAR(double(r[1]) / r[2], 2.0, 0.4);
+    // Flat: one layer, lambda * N cells over the area.
+    r = grid_resolution({3, 3, 0}, 1000, 4, 1 << 26);
+    EXPECT_EQ(r[2], 1);
+    EXPECT_NEAR(double(total(r)), 4000.0, 4000.0 * 0.2);
+    // Nearly flat: the thin axis has one cell, the others still share the density.
+    r = grid_resolution({3, 1e-4f, 3}, 1000, 4, 1 << 26);
+    EXPECT_EQ(r[1], 1);
+    EXPECT_NEAR(double(total(r)), 4000.0, 4000.0 * 0.2);
+    // A line, a point, nothing.
+    r = grid_resolution({0, 0, 5}, 100, 4, 1 << 26);
+    EXPECT_EQ(r, (std::array<int, 3>{1, 1, 400}));
+    EXPECT_EQ(grid_resolution({0, 0, 0}, 100, 4, 1 << 26), (std::array<int, 3>{1, 1, 1}));
+    EXPECT_EQ(grid_resolution({1, 1, 1}, 0, 4, 1 << 26), (std::array<int, 3>{1, 1, 1}));
+    // Absurd inputs stay within the cap and give every axis a cell.
+    for (const Vec3f& e : {Vec3f{1e30f, 1, 1e-30f}, Vec3f{1e-30f, 1e-30f, 1e-30f}, Vec3f{1e20f, 1e20f, 1e20f},
+                           Vec3f{1, 1e6f, 1}}) {
+        for (std::size_t n : {std::size_t(1), std::size_t(1000), std::size_t(1) << 40}) {
+            r = grid_resolution(e, n, 4, 1 << 20);
+            EXPECT_LE(total(r), std::size_t(1) << 20);
+            for (int k : r) EXPECT_GE(k, 1);
+        }
+    }
+    r = grid_resolution({1, 1, 1}, std::size_t(1) << 40, 1e30f, 1000);
+    EXPECT_LE(total(r), 1000u);
+    EXPECT_GE(total(r), 500u);
+}
+
+// ---- Triangle-box overlap against clipping ----------------------------------------------
+
+/// Reference: clip the triangle against the six planes of the box
+/// (Sutherland-Hodgman) in long double; it overlaps iff something is left.
+bool clip_overlap(const Vec3d& lo, const Vec3d& hi, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+    using P = std::array<long double, 3>;
+    std::vector<P> poly = {{a.x, a.y, a.z}, {b.x, b.y, b.z}, {c.x, c.y, c.z}};
+    for (int axis = 0; axis < 3; ++axis) {
+        for (int side = 0; side < 2; ++side) {
+            const long double bound = side ? hi[axis] : lo[axis];
+            auto inside = [&](const P& p) { return side ? p[axis] <= bound : p[axis] >= bound; };
+            std::vector<P> out;
+            for (std::size_t i = 0; i < poly.size(); ++i) {
+                const P& p = poly[i];
+                const P& q = poly[(i + 1) % poly.size()];
+                if (inside(p)) out.push_back(p);
+                if (inside(p) != inside(q)) {
+                    const long double t = (bound - p[axis]) / (q[axis] - p[axis]);
+                    P m;
+                    for (int k = 0; k < 3; ++k) m[k] = p[k] + (q[k] - p[k]) * t;
+                    m[axis] = bound;
+                    out.push_back(m);
+                }
+            }
+            poly = std::move(out);
+            if (poly.empty()) return false;
+        }
+    }
+    return true;
+}
+
+bool sat(const Vec3d& lo, const Vec3d& hi, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+    return triangle_box_overlap((lo + hi) * 0.5, (hi - lo) * 0.5, a, b, c);
+}
+
+TEST_F(Grid, TriangleBoxOverlapMatchesClipping) {
+    std::mt19937 rng(23);
+    std::uniform_real_distribution<double> u(-1, 1);
+    int decided_in = 0, decided_out = 0, bbox_only_wrong = 0;
+    for (int i = 0; i < 40000; ++i) {
+        const Vec3d center{u(rng) * 0.3, u(rng) * 0.3, u(rng) * 0.3};
+        const Vec3d half{0.05 + 0.3 * std::fabs(u(rng)), 0.05 + 0.3 * std::fabs(u(rng)), 0.05 + 0.3 * std::fabs(u(rng))};
+        const double scale = i % 2 ? 0.2 : 1.0;  // small triangles near the box, and large ones
+        const Vec3d a = Vec3d{u(rng), u(rng), u(rng)} * 0.6;
+        const Vec3d b = a + Vec3d{u(rng), u(rng), u(rng)} * scale, c = a + Vec3d{u(rng), u(rng), u(rng)} * scale;
+        const Vec3d lo = center - half, hi = center + half;
+        const bool got = sat(lo, hi, a, b, c);
+        const Vec3d d{1e-9, 1e-9, 1e-9};
+        if (clip_overlap(lo + d, hi - d, a, b, c)) {
+            ++decided_in;
+            EXPECT_TRUE(got) << i;
+        } else if (!clip_overlap(lo - d, hi + d, a, b, c)) {
+            ++decided_out;
+            EXPECT_FALSE(got) << i;
+            Box3<double> tb;
+            tb.extend(a), tb.extend(b), tb.extend(c);
+            const bool boxes_meet = !(tb.lo.x > hi.x || tb.hi.x < lo.x || tb.lo.y > hi.y || tb.hi.y < lo.y ||
+                                      tb.lo.z > hi.z || tb.hi.z < lo.z);
+            bbox_only_wrong += boxes_meet;
+        }
+        // Sampled points of the triangle inside the box imply overlap.
+        for (int k = 0; k < 8; ++k) {
+            double s = std::fabs(u(rng)), t = std::fabs(u(rng));
+            if (s + t > 1) s = 1 - s, t = 1 - t;
+            const Vec3d p = a + (b - a) * s + (c - a) * t;
+            if (p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y && p.z >= lo.z && p.z <= hi.z) {
+                EXPECT_TRUE(got) << i;
+            }
+        }
+    }
+    EXPECT_GT(decided_in, 5000);
+    EXPECT_GT(decided_out, 5000);
+    EXPECT_GT(bbox_only_wrong, 1000) << "cases where the bounding boxes meet but the triangle does not";
+}
+
+TEST_F(Grid, TriangleBoxOverlapTouchingCases) {
+    const Vec3d lo{0, 0, 0}, hi{1, 1, 1};
+    const double e = 1e-9;
+    struct Case {
+        const char* what;
+        Vec3d a, b, c;
+        bool overlap;
+    };
+    const Case cases[] = {
+        // Along a box edge, otherwise outside; then moved off it.
+        {"edge on box edge", {0, 0, 0}, {1, 0, 0}, {0.5, -1, -1}, true},
+        {"edge off box edge", {0, -e, -e}, {1, -e, -e}, {0.5, -1, -1}, false},
+        // A vertex on a box corner, the rest outside.
+        {"vertex on corner", {1, 1, 1}, {2, 1.5, 1}, {1.5, 2, 3}, true},
+        {"vertex off corner", {1 + e, 1 + e, 1 + e}, {2, 1.5, 1 + e}, {1.5, 2, 3}, false},
+        // A triangle edge crossing a box edge at one point.
+        {"edge crosses box edge", {2, 0, 0.5}, {0, 2, 0.5}, {2, 2, 0.5}, true},
+        {"edge misses box edge", {2 + e, 0, 0.5}, {0, 2 + e, 0.5}, {2, 2, 0.5}, false},
+        // The plane through one box corner, the corner inside the triangle.
+        {"plane on corner", {3, 0, 0}, {0, 3, 0}, {0, 0, 3}, true},
+        {"plane past corner", {3 + 1e-6, 0, 0}, {0, 3 + 1e-6, 0}, {0, 0, 3 + 1e-6}, false},
+        // In a face's plane, overlapping the face, and next to it.
+        {"in face plane", {0.2, 0.2, 1}, {2, 0.5, 1}, {0.5, 2, 1}, true},
+        {"above face plane", {0.2, 0.2, 1 + e}, {2, 0.5, 1 + e}, {0.5, 2, 1 + e}, false},
+        // Bounding boxes meet, triangles do not (the edge axes separate).
+        {"edge axis separates", {1.5, 0.9, 0.5}, {0.9, 1.5, 0.5}, {1.5, 1.5, 0.5}, false},
+        {"plane separates", {2, 0, 0}, {0, 2, 0}, {0, 0, 2}, false},  // against the half box below
+        // Through the middle with every vertex outside.
+        {"big through middle", {-5, -5, 0.5}, {5, -5, 0.5}, {0, 5, 0.6}, true},
+        // Degenerate: a segment through the box, a segment beside it, a point inside.
+        {"segment through", {-1, 0.5, 0.5}, {2, 0.5, 0.5}, {0.5, 0.5, 0.5}, true},
+        {"segment beside", {1.5, 0.9, 0.5}, {0.9, 1.5, 0.5}, {1.2, 1.2, 0.5}, false},
+        {"point inside", {0.5, 0.5, 0.5}, {0.5, 0.5, 0.5}, {0.5, 0.5, 0.5}, true},
+    };
+    for (const Case& k : cases) {
+        const Vec3d h = std::string(k.what) == "plane separates" ? Vec3d{0.5, 0.5, 0.5} : hi;
+        EXPECT_EQ(sat(lo, h, k.a, k.b, k.c), k.overlap) << k.what;
+        if (k.a == k.b) continue;  // clipping needs a proper polygon
+        if (std::string(k.what).find("plane") == std::string::npos || k.overlap) {
+            EXPECT_EQ(clip_overlap(lo, h, k.a, k.b, k.c), k.overlap) << "reference: " << k.what;
+        }
+    }
+}
+
+// ---- Placement: exactly the cells a triangle meets ------------------------------------------
+
+TEST_F(Grid, TrianglesAreInExactlyTheCellsTheyMeet) {
+    const Scene scene = load_scene(std::string(RAYPACK_SOURCE_DIR) + "/scenes/teapot.nff");
+    const auto grid = make_grid(scene);
+    const raypack::Grid& gr = grid->grid();
+    const GridGeometry& g = gr.geometry;
+    const double margin = grid_placement_margin(scene_bounds(scene));
+    std::size_t checked_in = 0, checked_out = 0;
+    for (std::uint32_t p = 0; p < scene.primitive_count(); ++p) {
+        if (scene.prims[p].kind != PrimKind::Triangle) continue;
+        const std::uint32_t i = scene.prims[p].index;
+        const Vec3d a(scene.triangles.p0[i]), b(scene.triangles.p1[i]), c(scene.triangles.p2[i]);
+        const Box3f box = primitive_bounds(scene, p);
+        int i0[3], i1[3];
+        for (int k = 0; k < 3; ++k) {
+            i0[k] = std::max(0, int(std::floor((box.lo[k] - g.bounds.lo[k]) * g.inv_cell_size[k])) - 1);
+            i1[k] = std::min(g.res[k] - 1, int(std::floor((box.hi[k] - g.bounds.lo[k]) * g.inv_cell_size[k])) + 1);
+        }
+        for (int z = i0[2]; z <= i1[2]; ++z) {
+            for (int y = i0[1]; y <= i1[1]; ++y) {
+                for (int x = i0[0]; x <= i1[0]; ++x) {
+                    const std::uint32_t cell = g.cell_index(x, y, z);
+                    const auto first = gr.refs.begin() + gr.cell_begin[cell], last = gr.refs.begin() + gr.cell_begin[cell + 1];
+                    const bool present = std::binary_search(first, last, p);
+                    const Vec3d lo{g.plane(0, x), g.plane(1, y), g.plane(2, z)};
+                    const Vec3d hi{g.plane(0, x + 1), g.plane(1, y + 1), g.plane(2, z + 1)};
+                    const Vec3d m{2 * margin, 2 * margin, 2 * margin};
+                    if (clip_overlap(lo, hi, a, b, c)) {
+                        ++checked_in;
+                        EXPECT_TRUE(present) << "triangle " << p << " cell " << x << " " << y << " " << z;
+                    } else if (!clip_overlap(lo - m, hi + m, a, b, c)) {
+                        ++checked_out;
+                        EXPECT_FALSE(present) << "triangle " << p << " cell " << x << " " << y << " " << z;
+                    }
+                }
+            }
+        }
+    }
+    // Nearly every reference is a real overlap; the rest are within the margin.
+    EXPECT_LE(checked_in, grid->reference_count());
+    EXPECT_GT(double(checked_in), 0.99 * double(grid->reference_count()));
+    EXPECT_GT(checked_out, 1000u);
+    // Exact placement stores fewer references than bounding boxes would.
+    GridConfig boxes_only;
+    boxes_only.exact_overlap = false;
+    EXPECT_LT(grid->reference_count(), make_grid(scene, boxes_only)->reference_count());
+}
+
+}  // namespace
+}  // namespace raypack::grid_test
