@@ -1,9 +1,77 @@
 #pragma once
-// Roots of a t^2 + 2 b t + c = 0 (note the half linear coefficient).
+// Roots of a t^2 + 2 b t + c = 0 (note the half linear coefficient), and the
+// lane-generic pieces the sphere and cone kernels share. The lane helpers
+// accept long double as well (scalar, for high-precision references in tests).
 #include <cmath>
+#include <type_traits>
 #include <utility>
 
+#include "kernels/simd.h"
+#include "kernels/vec3.h"
+
 namespace raypack {
+
+namespace lanes {
+
+template <class F> struct MaskType { using type = mask_of<F>; };
+template <> struct MaskType<long double> { using type = bool; };
+
+/// Mask of lane type F: bool for float, double and long double.
+template <class F> using Mask = typename MaskType<F>::type;
+
+template <class F>
+RAYPACK_INLINE F fma(const F& a, const F& b, const F& c) {
+    if constexpr (std::is_same_v<F, long double>) return std::fma(a, b, c);
+    else return vfmadd(a, b, c);
+}
+template <class F>
+RAYPACK_INLINE F sqrt(const F& x) {
+    if constexpr (std::is_same_v<F, long double>) return std::sqrt(x);
+#if defined(__AVX512F__)
+    // gcc 12's _mm512_sqrt_ps passes _mm512_undefined_ps() through, which
+    // -Wmaybe-uninitialized reports; the all-lanes masked form is the same
+    // instruction.
+    else if constexpr (sizeof(F) == 64) return _mm512_mask_sqrt_ps(x, __mmask16(0xFFFF), x);
+#endif
+    else return vsqrt(x);
+}
+template <class F>
+RAYPACK_INLINE F copysign(const F& x, const F& s) {
+    if constexpr (std::is_same_v<F, long double>) return std::copysign(x, s);
+    else return copysign_of(x, s);
+}
+
+/// a . b as one multiply and two fused multiply-adds (one instruction fewer
+/// than three products and two sums, and no rounding of two of the products).
+template <class F>
+RAYPACK_INLINE F dot(const Vec3<F>& a, const Vec3<F>& b) {
+    return lanes::fma(a.x, b.x, lanes::fma(a.y, b.y, a.z * b.z));
+}
+
+/// a - b * s, per component, fused.
+template <class F>
+RAYPACK_INLINE Vec3<F> sub_scaled(const Vec3<F>& a, const Vec3<F>& b, const F& s) {
+    const F ns = -s;
+    return {lanes::fma(b.x, ns, a.x), lanes::fma(b.y, ns, a.y), lanes::fma(b.z, ns, a.z)};
+}
+
+template <class F>
+RAYPACK_INLINE Vec3<F> sub(const Vec3<F>& a, const Vec3<F>& b) {
+    return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+
+/// The nearer of two roots lo <= hi inside [tnear, tfar]: narrows `valid` to
+/// the lanes that have one and writes it to `t` (every lane; meaningful on
+/// the returned ones). NaN roots are never inside.
+template <class F>
+RAYPACK_INLINE Mask<F> nearest_root(Mask<F> valid, const F& lo, const F& hi, const F& tnear, const F& tfar, F& t) {
+    const Mask<F> in_lo = (lo >= tnear) & (lo <= tfar);
+    const Mask<F> in_hi = (hi >= tnear) & (hi <= tfar);
+    t = select(in_lo, lo, hi);
+    return valid & (in_lo | in_hi);
+}
+
+}  // namespace lanes
 
 /// Numerically stable roots (Press et al., Numerical Recipes 5.6): the root
 /// that would suffer cancellation is taken from the product of the roots.

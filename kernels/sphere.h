@@ -1,49 +1,133 @@
 #pragma once
-// Scalar ray-sphere tests. Both return the nearest t in [tnear, tfar], so a
-// ray starting inside the sphere hits the far side.
+// Ray-sphere tests, written once for every lane type (kernels/simd.h): K rays
+// against one sphere (sphere fields broadcast) or one ray against K spheres
+// stored as SoA (ray fields broadcast). Every variant returns the lanes of
+// `valid` that hit, with the nearest root in [tnear, tfar] in `t`, so a ray
+// starting inside the sphere hits the far side. `t` is meaningful on the
+// returned lanes only. dir need not be unit length.
 #include "kernels/quadratic.h"
 #include "kernels/ray.h"
 
 namespace raypack {
 
-enum class SphereMethod { Algebraic, Geometric };
+enum class SphereMethod { Algebraic, Geometric, Precise };
 
-/// Textbook quadratic |o + t d - c|^2 = r^2, roots (-b -+ sqrt(b^2 - ac)) / a.
-/// Loses precision when the sphere is small and far away (cancellation in
-/// b^2 - ac); kept as the baseline the other methods are measured against.
-template <class T>
-bool intersect_sphere_algebraic(const Ray<T>& ray, const Vec3<T>& center, T radius, T& t) {
-    const Vec3<T> oc = ray.org - center;
-    const T a = dot(ray.dir, ray.dir);
-    const T b = dot(oc, ray.dir);
-    const T c = dot(oc, oc) - radius * radius;
-    const T disc = b * b - a * c;
-    if (!(disc >= T(0))) return false;
-    const T root = std::sqrt(disc);
-    return nearest_root_in((-b - root) / a, (-b + root) / a, ray.tnear, ray.tfar, t);
+/// Textbook quadratic |o + t d - c|^2 = r^2, roots (-b -+ sqrt(b^2 - ac)) / a
+/// (half linear coefficient b). Loses precision when the sphere is small and
+/// far away (cancellation in b^2 - ac); kept as the baseline the other
+/// methods are measured against.
+template <class F>
+RAYPACK_INLINE lanes::Mask<F> intersect_sphere_algebraic(lanes::Mask<F> valid, const Vec3<F>& org, const Vec3<F>& dir,
+                                                         const F& tnear, const F& tfar, const Vec3<F>& center,
+                                                         const F& radius, F& t) {
+    const Vec3<F> oc = lanes::sub(org, center);
+    const F a = lanes::dot(dir, dir);
+    const F b = lanes::dot(oc, dir);
+    const F c = lanes::dot(oc, oc) - radius * radius;
+    const F disc = lanes::fma(b, b, -(a * c));
+    valid = valid & (disc >= F(0));
+    if (none(valid)) return valid;
+    const F root = lanes::sqrt(disc);
+    const F inv_a = F(1) / a;
+    const F nb = -b;
+    return lanes::nearest_root(valid, (nb - root) * inv_a, (nb + root) * inv_a, tnear, tfar, t);
 }
 
 /// Geometric method (Haines, "Essential Ray Tracing Algorithms", in Glassner,
 /// An Introduction to Ray Tracing, 1989): project the centre onto the ray, then
 /// use the squared distance of the centre from the ray, which avoids
 /// subtracting two large nearly-equal numbers.
+template <class F>
+RAYPACK_INLINE lanes::Mask<F> intersect_sphere_geometric(lanes::Mask<F> valid, const Vec3<F>& org, const Vec3<F>& dir,
+                                                         const F& tnear, const F& tfar, const Vec3<F>& center,
+                                                         const F& radius, F& t) {
+    const Vec3<F> l = lanes::sub(center, org);
+    const F a = lanes::dot(dir, dir);
+    const F inv_a = F(1) / a;
+    const F tca = lanes::dot(l, dir) * inv_a;             // closest approach along the ray
+    const Vec3<F> perp = lanes::sub_scaled(l, dir, tca);  // centre minus closest point
+    const F d2 = lanes::dot(perp, perp);                  // squared distance centre-ray
+    const F r2 = radius * radius;
+    valid = valid & (d2 <= r2);
+    if (none(valid)) return valid;
+    const F thc = lanes::sqrt((r2 - d2) * inv_a);
+    return lanes::nearest_root(valid, tca - thc, tca + thc, tnear, tfar, t);
+}
+
+/// Haines, Guenther, Akenine-Moeller, "Precision Improvements for Ray/Sphere
+/// Intersection", Ray Tracing Gems ch. 7 (2019): with f = o - c and
+/// b = f . d, the discriminant b^2 - ac is a (r^2 - |f - (b/a) d|^2), from
+/// the squared distance of the centre to the ray (no cancellation of large
+/// terms), and the roots are the stable pair q / a, c / q with
+/// q = -(b + sign(b) sqrt(b^2 - ac)) (Press et al., Numerical Recipes 5.6).
+template <class F>
+RAYPACK_INLINE lanes::Mask<F> intersect_sphere_precise(lanes::Mask<F> valid, const Vec3<F>& org, const Vec3<F>& dir,
+                                                       const F& tnear, const F& tfar, const Vec3<F>& center,
+                                                       const F& radius, F& t) {
+    const Vec3<F> f = lanes::sub(org, center);
+    const F a = lanes::dot(dir, dir);
+    const F inv_a = F(1) / a;
+    const F b = lanes::dot(f, dir);
+    const Vec3<F> l = lanes::sub_scaled(f, dir, b * inv_a);  // f minus its projection on the ray
+    const F r2 = radius * radius;
+    const F h2 = r2 - lanes::dot(l, l);  // discriminant / a
+    valid = valid & (h2 >= F(0));
+    if (none(valid)) return valid;
+    // c with the same r2 as h2: then h2 == 0 with b == 0 (a tangent ray from
+    // the surface) gives c == 0 and the 0 / 0 below is dropped by vmin/vmax.
+    const F c = lanes::dot(f, f) - r2;
+    const F q = -(b + lanes::copysign(lanes::sqrt(a * h2), b));
+    const F t_q = q * inv_a, t_c = c / q;
+    // vmin/vmax return the second operand when the first is NaN (q == 0).
+    return lanes::nearest_root(valid, vmin(t_c, t_q), vmax(t_c, t_q), tnear, tfar, t);
+}
+
+/// The variant chosen at compile time.
+template <SphereMethod Method, class F>
+RAYPACK_INLINE lanes::Mask<F> intersect_sphere(lanes::Mask<F> valid, const Vec3<F>& org, const Vec3<F>& dir,
+                                               const F& tnear, const F& tfar, const Vec3<F>& center, const F& radius,
+                                               F& t) {
+    if constexpr (Method == SphereMethod::Algebraic)
+        return intersect_sphere_algebraic<F>(valid, org, dir, tnear, tfar, center, radius, t);
+    else if constexpr (Method == SphereMethod::Geometric)
+        return intersect_sphere_geometric<F>(valid, org, dir, tnear, tfar, center, radius, t);
+    else
+        return intersect_sphere_precise<F>(valid, org, dir, tnear, tfar, center, radius, t);
+}
+
+// ---- Scalar entry points: one ray, one sphere; `t` untouched on a miss -----
+
+template <SphereMethod Method, class T>
+bool intersect_sphere(const Ray<T>& ray, const Vec3<T>& center, T radius, T& t) {
+    T tt;
+    if (!intersect_sphere<Method, T>(true, ray.org, ray.dir, ray.tnear, ray.tfar, center, radius, tt)) return false;
+    t = tt;
+    return true;
+}
+
+template <class T>
+bool intersect_sphere_algebraic(const Ray<T>& ray, const Vec3<T>& center, T radius, T& t) {
+    return intersect_sphere<SphereMethod::Algebraic>(ray, center, radius, t);
+}
+
 template <class T>
 bool intersect_sphere_geometric(const Ray<T>& ray, const Vec3<T>& center, T radius, T& t) {
-    const Vec3<T> l = center - ray.org;
-    const T a = dot(ray.dir, ray.dir);
-    const T tca = dot(l, ray.dir) / a;               // closest approach along the ray
-    const Vec3<T> perp = l - ray.dir * tca;          // centre minus closest point
-    const T d2 = dot(perp, perp);                    // squared distance centre-ray
-    const T r2 = radius * radius;
-    if (!(d2 <= r2)) return false;
-    const T thc = std::sqrt((r2 - d2) / a);
-    return nearest_root_in(tca - thc, tca + thc, ray.tnear, ray.tfar, t);
+    return intersect_sphere<SphereMethod::Geometric>(ray, center, radius, t);
+}
+
+template <class T>
+bool intersect_sphere_precise(const Ray<T>& ray, const Vec3<T>& center, T radius, T& t) {
+    return intersect_sphere<SphereMethod::Precise>(ray, center, radius, t);
 }
 
 template <class T>
 bool intersect_sphere(SphereMethod method, const Ray<T>& ray, const Vec3<T>& center, T radius, T& t) {
-    return method == SphereMethod::Algebraic ? intersect_sphere_algebraic(ray, center, radius, t)
-                                             : intersect_sphere_geometric(ray, center, radius, t);
+    switch (method) {
+        case SphereMethod::Algebraic: return intersect_sphere<SphereMethod::Algebraic>(ray, center, radius, t);
+        case SphereMethod::Geometric: return intersect_sphere<SphereMethod::Geometric>(ray, center, radius, t);
+        case SphereMethod::Precise: break;
+    }
+    return intersect_sphere<SphereMethod::Precise>(ray, center, radius, t);
 }
 
 }  // namespace raypack
