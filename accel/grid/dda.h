@@ -8,9 +8,9 @@
 // each lane its own and step them independently.
 //
 // Robustness choices:
-// - The crossing distance of the next plane is computed afresh from the cell
-//   index at every step, t = (plane - org) / dir, instead of accumulating
-//   tDelta: its error stays a few ulps however many cells are crossed.
+// - The crossing distance of the k-th plane is t_first + k * tDelta with one
+//   fused multiply-add, instead of accumulating tDelta k times: its error
+//   stays a few ulps of t however many cells are crossed.
 // - A direction component below kMinRcpInput in magnitude (including +-0)
 //   never steps along its axis, just as the robust slab test treats it as
 //   parallel; its crossing distance is +infinity.
@@ -41,32 +41,30 @@ public:
     /// reciprocal(dir), computed once by the caller for the slab test too.
     RAYPACK_INLINE GridDda(const GridGeometry& g, const Vec3f& org, const Vec3f& dir, const Vec3f& inv_dir,
                            float t_start)
-        : g_(&g), org_(org), inv_dir_(inv_dir), t_enter_(t_start) {
+        : t_enter_(t_start) {
         const Vec3f p = org + dir * t_start;
         std::int32_t stride = 1;
-        cell_ = 0;
         for (int a = 0; a < 3; ++a) {
             // Cell of the start point; the comparisons also send NaN to cell 0.
             const float last = float(g.res[a] - 1);
             float f = (p[a] - g.bounds.lo[a]) * g.inv_cell_size[a];
             f = f > 0.0f ? f : 0.0f;
             f = f < last ? f : last;
-            idx_[a] = int(f);
-            cell_ += idx_[a] * stride;
+            const int i = int(f);
+            cell_ += i * stride;
+            steps_[a] = 0;
             if (std::fabs(dir[a]) < kMinRcpInput || !(dir[a] == dir[a])) {
-                step_[a] = 0;
-                end_[a] = -2;  // never reached
-                t_next_[a] = std::numeric_limits<float>::infinity();
-            } else if (dir[a] > 0) {
-                step_[a] = 1;
-                end_[a] = g.res[a];
-                t_next_[a] = crossing(a, idx_[a] + 1);
+                left_[a] = 0;
+                stride_[a] = 0;
+                t_first_[a] = t_next_[a] = std::numeric_limits<float>::infinity();
+                t_delta_[a] = 0;
             } else {
-                step_[a] = -1;
-                end_[a] = -1;
-                t_next_[a] = crossing(a, idx_[a]);
+                const bool up = dir[a] > 0;
+                left_[a] = up ? g.res[a] - 1 - i : i;
+                stride_[a] = up ? stride : -stride;
+                t_first_[a] = t_next_[a] = (g.plane(a, up ? i + 1 : i) - org[a]) * inv_dir[a];
+                t_delta_[a] = g.cell_size[a] * std::fabs(inv_dir[a]);
             }
-            stride_[a] = step_[a] * stride;
             stride *= g.res[a];
         }
     }
@@ -75,34 +73,42 @@ public:
     /// left the grid.
     RAYPACK_INLINE std::optional<DdaSegment> next() {
         if (done_) return std::nullopt;
-        // Axis of the nearest plane crossing.
-        const int a = t_next_[0] < t_next_[1] ? (t_next_[0] < t_next_[2] ? 0 : 2) : (t_next_[1] < t_next_[2] ? 1 : 2);
-        const DdaSegment seg{std::uint32_t(cell_), t_enter_, t_next_[a]};
-        idx_[a] += step_[a];
-        if (idx_[a] == end_[a] || step_[a] == 0 || !(t_next_[a] < std::numeric_limits<float>::infinity())) {
-            done_ = true;
+        DdaSegment seg{std::uint32_t(cell_), t_enter_, 0.0f};
+        // Cross the nearest plane. One branch per axis, so that the state
+        // stays in registers (indexing it by a variable axis would not).
+        if (t_next_[0] < t_next_[1]) {
+            if (t_next_[0] < t_next_[2]) step<0>(seg);
+            else step<2>(seg);
         } else {
-            cell_ += stride_[a];
-            t_enter_ = t_next_[a];
-            t_next_[a] = crossing(a, step_[a] > 0 ? idx_[a] + 1 : idx_[a]);
+            if (t_next_[1] < t_next_[2]) step<1>(seg);
+            else step<2>(seg);
         }
         return seg;
     }
 
-    /// Cell coordinates of the current cell (for tests and statistics).
-    int index(int axis) const { return idx_[axis]; }
-
 private:
-    /// Parameter at which the ray crosses plane i of `axis`.
-    RAYPACK_INLINE float crossing(int axis, int i) const { return (g_->plane(axis, i) - org_[axis]) * inv_dir_[axis]; }
+    template <int A>
+    RAYPACK_INLINE void step(DdaSegment& seg) {
+        seg.t_exit = t_next_[A];
+        if (left_[A] == 0) {  // also every axis parallel: the ray stays in this cell
+            done_ = true;
+            return;
+        }
+        --left_[A];
+        cell_ += stride_[A];
+        t_enter_ = t_next_[A];
+        // Plane k along the axis is crossed at t_first + k * t_delta: one
+        // rounding of a product, not k roundings of a running sum, so the
+        // error stays a few ulps of t however far the walk goes.
+        steps_[A] += 1.0f;
+        t_next_[A] = std::fma(steps_[A], t_delta_[A], t_first_[A]);
+    }
 
-    const GridGeometry* g_;
-    Vec3f org_, inv_dir_;
     float t_enter_;
-    float t_next_[3];
-    int idx_[3], step_[3], end_[3];
-    std::int32_t stride_[3];
-    std::int32_t cell_;
+    float t_next_[3], t_first_[3], t_delta_[3], steps_[3];
+    std::int32_t left_[3];    ///< planes still to cross along each axis before leaving the grid
+    std::int32_t stride_[3];  ///< change of the linear cell index per step
+    std::int32_t cell_ = 0;
     bool done_ = false;
 };
 

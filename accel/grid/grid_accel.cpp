@@ -2,6 +2,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <chrono>
 #include <vector>
 
@@ -11,7 +12,7 @@
 namespace raypack {
 
 GridAccel::GridAccel(const Scene& scene, const AccelConfig& config, const GridConfig& grid_config)
-    : scene_(&scene), kernels_(config.kernels) {
+    : scene_(&scene), kernels_(config.kernels), mailbox_(grid_config.mailbox) {
     const auto start = std::chrono::steady_clock::now();
     const std::size_t n = scene.primitive_count();
     std::vector<Box3f> boxes(n);
@@ -43,9 +44,9 @@ double GridAccel::empty_cell_fraction() const {
 // kernels report is a genuine hit in [tnear, tfar] and shrinks tfar, even if
 // it lies beyond the current cell (a primitive spanning cells); the walk
 // stops once the current cell ends past tfar, since no later cell can then
-// hold a nearer hit (pbrt-v1 GridAccel). No mailbox: re-testing a primitive
-// in a later cell gives the same answer, so it costs time, not correctness.
-template <bool AnyHit, bool Counting>
+// hold a nearer hit (as pbrt-v1's GridAccel). The mailbox only saves time:
+// re-testing a primitive gives the same answer as before.
+template <bool AnyHit, bool Counting, bool Mailbox>
 bool GridAccel::trace(Rayf& ray, Hitf& hit, GridRayCounters* counters) const {
     if constexpr (Counting) ++counters->rays;
     if (grid_.empty()) return false;
@@ -55,16 +56,27 @@ bool GridAccel::trace(Rayf& ray, Hitf& hit, GridRayCounters* counters) const {
     const PrimitiveIntersector<float> isect{scene_, kernels_};
     const std::uint32_t* begin = grid_.cell_begin.data();
     const std::uint32_t* refs = grid_.refs.data();
+    // Direct-mapped on the primitive number: a collision only costs a re-test.
+    constexpr std::uint32_t kMailboxSize = 16;
+    std::uint32_t mailbox[Mailbox ? kMailboxSize : 1];
+    if constexpr (Mailbox) std::fill(mailbox, mailbox + kMailboxSize, kNoPrim);
     GridDda dda(grid_.geometry, ray.org, ray.dir, inv_dir, entry);
     bool found = false;
     while (const std::optional<DdaSegment> seg = dda.next()) {
         const std::uint32_t first = begin[seg->cell], last = begin[seg->cell + 1];
-        if constexpr (Counting) {
-            ++counters->cells_visited;
-            counters->prim_tests += last - first;
-        }
+        if constexpr (Counting) ++counters->cells_visited;
         for (std::uint32_t k = first; k < last; ++k) {
-            if (isect.intersect(refs[k], ray, hit)) {
+            const std::uint32_t prim = refs[k];
+            if constexpr (Mailbox) {
+                std::uint32_t& slot = mailbox[prim & (kMailboxSize - 1)];
+                if (slot == prim) {
+                    if constexpr (Counting) ++counters->mailbox_skips;
+                    continue;
+                }
+                slot = prim;
+            }
+            if constexpr (Counting) ++counters->prim_tests;
+            if (isect.intersect(prim, ray, hit)) {
                 found = true;
                 if constexpr (AnyHit) return true;
             }

@@ -12,7 +12,8 @@ namespace raypack {
 struct GridRayCounters {
     std::uint64_t rays = 0;
     std::uint64_t cells_visited = 0;  ///< cells the DDA yielded, empty ones included
-    std::uint64_t prim_tests = 0;     ///< ray-primitive tests, repeats in later cells included
+    std::uint64_t prim_tests = 0;     ///< ray-primitive tests run
+    std::uint64_t mailbox_skips = 0;  ///< repeated tests the mailbox avoided
 };
 
 class GridAccel final : public Accel {
@@ -39,13 +40,19 @@ public:
     std::size_t empty_cells() const { return empty_cells_; }
 
 private:
-    template <bool AnyHit, bool Counting>
+    template <bool AnyHit, bool Counting, bool Mailbox>
     bool trace(Rayf& ray, Hitf& hit, GridRayCounters* counters) const;
+    template <bool AnyHit, bool Counting>
+    bool trace(Rayf& ray, Hitf& hit, GridRayCounters* counters) const {
+        return mailbox_ ? trace<AnyHit, Counting, true>(ray, hit, counters)
+                        : trace<AnyHit, Counting, false>(ray, hit, counters);
+    }
 
     const Scene* scene_;
     KernelChoice kernels_;
     Grid grid_;
     std::size_t empty_cells_ = 0;
+    bool mailbox_ = true;
     AccelStats stats_;
 };
 
