@@ -41,18 +41,19 @@ RAYPACK_INLINE ConeLanes<F> make_cone(const Vec3<F>& base, const F& base_radius,
 /// is the mirrored nappe, r(s) < 0). Returns the lanes of `valid` that hit
 /// within [tnear, tfar], with the nearest such t in `t` and s / h (0 at the
 /// base) in `s_frac`, meaningful on those lanes only. A ray parallel to a
-/// generator line (a == 0, e.g. along a cylinder's axis) misses.
+/// generator line crosses the surface once; one along a cylinder's axis
+/// never does.
 template <class F>
-RAYPACK_INLINE lanes::Mask<F> intersect_cone(lanes::Mask<F> valid, const Vec3<F>& org, const Vec3<F>& dir,
-                                             const F& tnear, const F& tfar, const ConeLanes<F>& cone, F& t,
-                                             F& s_frac) {
+RAYPACK_INLINE lanes::Mask<F> intersect_cone(lanes::Mask<F> valid, const QuadricRay<F>& ray, const ConeLanes<F>& cone,
+                                             F& t, F& s_frac) {
+    const Vec3<F>& org = ray.org;
+    const Vec3<F>& dir = ray.dir;
     // Move the origin to the ray's closest approach to the cone's middle
     // first: for a thin cone seen from afar, |co|^2 - r0^2 would otherwise
     // lose r0^2 to cancellation (the re-centring of Haines et al., "Precision
     // Improvements for Ray/Sphere Intersection", Ray Tracing Gems ch. 7).
     // Any t_mid near the projection works: the roots are relative to it.
-    const F dd = lanes::dot(dir, dir);
-    const F t_mid = lanes::dot(lanes::sub(cone.mid, org), dir) / dd;
+    const F t_mid = lanes::dot(lanes::sub(cone.mid, org), dir) * ray.inv_dd;
     const Vec3<F> co = {lanes::fma(dir.x, t_mid, org.x) - cone.base.x, lanes::fma(dir.y, t_mid, org.y) - cone.base.y,
                         lanes::fma(dir.z, t_mid, org.z) - cone.base.z};
     // Work with the components perpendicular to the axis, so that nothing
@@ -64,31 +65,42 @@ RAYPACK_INLINE lanes::Mask<F> intersect_cone(lanes::Mask<F> valid, const Vec3<F>
     const F r0 = lanes::fma(cone.k, s0, cone.rb);
     const F kds = cone.k * ds;
     // a t^2 + 2 b t + c = 0 in t relative to t_mid.
-    const F a = lanes::fma(-kds, kds, lanes::dot(d_perp, d_perp));
-    const F b = lanes::fma(-r0, kds, lanes::dot(co_perp, d_perp));
-    const F c = lanes::fma(-r0, r0, lanes::dot(co_perp, co_perp));
-    const F disc = lanes::fma(b, b, -(a * c));
-    valid = valid & (disc >= F(0)) & (a != F(0));
+    const F a = lanes::fnma(kds, kds, lanes::dot(d_perp, d_perp));
+    const F b = lanes::fnma(r0, kds, lanes::dot(co_perp, d_perp));
+    const F c = lanes::fnma(r0, r0, lanes::dot(co_perp, co_perp));
+    const F disc = lanes::fms(b, b, a * c);
+    valid = valid & (disc >= F(0));
     if (none(valid)) return valid;
     // Stable root pair (Press et al., Numerical Recipes 5.6). q == 0 only
-    // when b == 0 and c == 0 (double root at 0): c / q is then NaN, and
-    // vmin/vmax, which return the second operand on NaN, give q / a twice.
+    // when b == 0 and c == 0 (double root at 0, with a != 0): c / q is then
+    // NaN, and vmin/vmax, which return the second operand on NaN, give q / a
+    // twice. a == 0 (parallel to a generator line) leaves the one crossing
+    // c / q = -c / 2b and q / a = +-inf, which fails the end test; with
+    // b == 0 as well (along a cylinder's axis) both are NaN.
     const F q = -(b + lanes::copysign(lanes::sqrt(disc), b));
     const F t_q = q / a, t_c = c / q;
     const F lo = vmin(t_c, t_q), hi = vmax(t_c, t_q);
     // A root counts when it is within [tnear, tfar] and between the ends.
     const F t_lo = t_mid + lo, t_hi = t_mid + hi;
     const F s_lo = lanes::fma(lo, ds, s0), s_hi = lanes::fma(hi, ds, s0);
-    const lanes::Mask<F> in_lo = (t_lo >= tnear) & (t_lo <= tfar) & (s_lo >= F(0)) & (s_lo <= cone.h) &
+    const lanes::Mask<F> in_lo = (t_lo >= ray.tnear) & (t_lo <= ray.tfar) & (s_lo >= F(0)) & (s_lo <= cone.h) &
                                  (lanes::fma(cone.k, s_lo, cone.rb) >= F(0));
-    const lanes::Mask<F> in_hi = (t_hi >= tnear) & (t_hi <= tfar) & (s_hi >= F(0)) & (s_hi <= cone.h) &
+    const lanes::Mask<F> in_hi = (t_hi >= ray.tnear) & (t_hi <= ray.tfar) & (s_hi >= F(0)) & (s_hi <= cone.h) &
                                  (lanes::fma(cone.k, s_hi, cone.rb) >= F(0));
     t = select(in_lo, t_lo, t_hi);
     s_frac = select(in_lo, s_lo, s_hi) * cone.inv_h;
     return valid & (in_lo | in_hi);
 }
 
-/// The same from the cone's end points (computes ConeLanes on the way).
+/// The same from the ray's fields.
+template <class F>
+RAYPACK_INLINE lanes::Mask<F> intersect_cone(lanes::Mask<F> valid, const Vec3<F>& org, const Vec3<F>& dir,
+                                             const F& tnear, const F& tfar, const ConeLanes<F>& cone, F& t,
+                                             F& s_frac) {
+    return intersect_cone<F>(valid, make_quadric_ray<F>(org, dir, tnear, tfar), cone, t, s_frac);
+}
+
+/// The same from the ray's fields and the cone's end points.
 template <class F>
 RAYPACK_INLINE lanes::Mask<F> intersect_cone(lanes::Mask<F> valid, const Vec3<F>& org, const Vec3<F>& dir,
                                              const F& tnear, const F& tfar, const Vec3<F>& base,

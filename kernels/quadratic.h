@@ -24,6 +24,28 @@ RAYPACK_INLINE F fma(const F& a, const F& b, const F& c) {
     if constexpr (std::is_same_v<F, long double>) return std::fma(a, b, c);
     else return vfmadd(a, b, c);
 }
+/// c - a * b and a * b - c with one rounding: the same values as fma(-a, b, c)
+/// and fma(a, b, -c), without the negation (vfnmadd / vfmsub).
+template <class F>
+RAYPACK_INLINE F fnma(const F& a, const F& b, const F& c) {
+    if constexpr (std::is_floating_point_v<F>) return std::fma(-a, b, c);
+    else if constexpr (sizeof(F) == 16) return _mm_fnmadd_ps(a, b, c);
+    else if constexpr (sizeof(F) == 32) return _mm256_fnmadd_ps(a, b, c);
+#if defined(__AVX512F__)
+    else if constexpr (sizeof(F) == 64) return _mm512_fnmadd_ps(a, b, c);
+#endif
+    else static_assert(sizeof(F) == 0, "fnma: unsupported width");
+}
+template <class F>
+RAYPACK_INLINE F fms(const F& a, const F& b, const F& c) {
+    if constexpr (std::is_floating_point_v<F>) return std::fma(a, b, -c);
+    else if constexpr (sizeof(F) == 16) return _mm_fmsub_ps(a, b, c);
+    else if constexpr (sizeof(F) == 32) return _mm256_fmsub_ps(a, b, c);
+#if defined(__AVX512F__)
+    else if constexpr (sizeof(F) == 64) return _mm512_fmsub_ps(a, b, c);
+#endif
+    else static_assert(sizeof(F) == 0, "fms: unsupported width");
+}
 template <class F>
 RAYPACK_INLINE F sqrt(const F& x) {
     if constexpr (std::is_same_v<F, long double>) return std::sqrt(x);
@@ -51,8 +73,7 @@ RAYPACK_INLINE F dot(const Vec3<F>& a, const Vec3<F>& b) {
 /// a - b * s, per component, fused.
 template <class F>
 RAYPACK_INLINE Vec3<F> sub_scaled(const Vec3<F>& a, const Vec3<F>& b, const F& s) {
-    const F ns = -s;
-    return {lanes::fma(b.x, ns, a.x), lanes::fma(b.y, ns, a.y), lanes::fma(b.z, ns, a.z)};
+    return {lanes::fnma(b.x, s, a.x), lanes::fnma(b.y, s, a.y), lanes::fnma(b.z, s, a.z)};
 }
 
 template <class F>
@@ -60,15 +81,36 @@ RAYPACK_INLINE Vec3<F> sub(const Vec3<F>& a, const Vec3<F>& b) {
     return {a.x - b.x, a.y - b.y, a.z - b.z};
 }
 
+}  // namespace lanes
+
+/// What the sphere and cone tests need of a ray, computed once per ray like
+/// the slab test's reciprocal direction: |dir|^2 (the t^2 coefficient of
+/// every quadric) and its reciprocal, so that the kernels need not divide by it.
+template <class F>
+struct QuadricRay {
+    Vec3<F> org, dir;
+    F tnear, tfar;
+    F dd;      ///< dir . dir
+    F inv_dd;  ///< 1 / (dir . dir)
+};
+
+template <class F>
+RAYPACK_INLINE QuadricRay<F> make_quadric_ray(const Vec3<F>& org, const Vec3<F>& dir, const F& tnear, const F& tfar) {
+    const F dd = lanes::dot(dir, dir);
+    return {org, dir, tnear, tfar, dd, F(1) / dd};
+}
+
+namespace lanes {
+
 /// The nearer of two roots lo <= hi inside [tnear, tfar]: narrows `valid` to
 /// the lanes that have one and writes it to `t` (every lane; meaningful on
-/// the returned ones). NaN roots are never inside.
+/// the returned ones). NaN roots are never inside. lo is the answer if it is
+/// past tnear (then hi, further still, cannot be in when lo is past tfar);
+/// otherwise hi is.
 template <class F>
 RAYPACK_INLINE Mask<F> nearest_root(Mask<F> valid, const F& lo, const F& hi, const F& tnear, const F& tfar, F& t) {
-    const Mask<F> in_lo = (lo >= tnear) & (lo <= tfar);
-    const Mask<F> in_hi = (hi >= tnear) & (hi <= tfar);
-    t = select(in_lo, lo, hi);
-    return valid & (in_lo | in_hi);
+    t = select(lo >= tnear, lo, hi);
+    return valid & (t >= tnear) & (t <= tfar);
 }
 
 }  // namespace lanes
