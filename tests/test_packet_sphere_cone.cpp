@@ -19,13 +19,16 @@
 //    N u (|o - c|^2 + r^2) for algebraic, which squares the distance before
 //    subtracting; cone: N u P (h + r_max)(1 + |k|)). The last term is the
 //    usual root perturbation dC / |f'(t)|, capped by sqrt(dC / A) where the
-//    ray grazes the surface (sep -> 0). Hit-vs-miss differences and t beyond
-//    the bound must be explained: the double kernel gives the float answer
-//    for a ray whose origin (or tnear, tfar) moves by the same error, i.e.
-//    the ray is within that tolerance of the silhouette, an open end, or an
-//    end of [tnear, tfar]. Their number is reported and bounded.
+//    ray grazes the surface (sep -> 0). N = 16 for algebraic, 8 for the
+//    others. Hit-vs-miss differences and t beyond the bound must each be
+//    explained by a decision within the same error of going the other way,
+//    from long double geometry: tangent (the roots within sqrt(dC / A) of
+//    merging), a root within the bound of tnear or tfar, a root's axial
+//    position within its error of an open end or the apex (cones), or a ray
+//    parallel to a generator line within rounding; a float hit must also be
+//    within twice the bound of a root. Their number is reported and bounded.
 // 3. Precise against algebraic on small far spheres: error statistics against
-//    the double precise kernel.
+//    the double precise kernel, asserted per distance.
 #include <gtest/gtest.h>
 
 #include <algorithm>
