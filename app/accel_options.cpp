@@ -11,8 +11,8 @@ std::vector<OptionSpec> accel_option_specs() {
 
 std::string accel_options_help() {
     return "  --accel " + accel_kinds_list() + "  acceleration structure (default bvh2)\n"
-           "  --sphere geometric|algebraic  ray-sphere test (default geometric)\n"
-           "  --triangle moeller|plane      ray-triangle test (default moeller)\n"
+           "  --sphere geometric|algebraic|precise     ray-sphere test (default geometric)\n"
+           "  --triangle moeller|watertight|plane     ray-triangle test (default moeller)\n"
            "  --packet 1|4|8|16             rays per packet (default 1; 16 needs AVX-512)\n";
 }
 
@@ -26,11 +26,13 @@ AccelConfig accel_config_from(const ParsedArgs& args) {
     const std::string sphere = args.text("--sphere", "geometric");
     if (sphere == "geometric") config.kernels.sphere = SphereMethod::Geometric;
     else if (sphere == "algebraic") config.kernels.sphere = SphereMethod::Algebraic;
-    else throw UsageError("--sphere: expected geometric or algebraic, got '" + sphere + "'");
+    else if (sphere == "precise") config.kernels.sphere = SphereMethod::Precise;
+    else throw UsageError("--sphere: expected geometric, algebraic or precise, got '" + sphere + "'");
     const std::string tri = args.text("--triangle", "moeller");
     if (tri == "moeller") config.kernels.triangle = TriangleMethod::Moeller;
     else if (tri == "plane") config.kernels.triangle = TriangleMethod::Plane;
-    else throw UsageError("--triangle: expected moeller or plane, got '" + tri + "'");
+    else if (tri == "watertight") config.kernels.triangle = TriangleMethod::Watertight;
+    else throw UsageError("--triangle: expected moeller, watertight or plane, got '" + tri + "'");
     return config;
 }
 
