@@ -56,9 +56,9 @@ template <class F>
 RAYPACK_INLINE void keep(const mask_of<F>& m, const F& t, const F& u, const F& v, F& kt, F& ku, F& kv,
                          std::uint32_t& count) {
     count += std::uint32_t(std::popcount(mask_bits(m)));
-    kt = select(m, t, kt);
-    ku = select(m, u, ku);
-    kv = select(m, v, kv);
+    kt = triangle_detail::blend(m, t, kt);
+    ku = triangle_detail::blend(m, u, ku);
+    kv = triangle_detail::blend(m, v, kv);
 }
 
 /// Publishes copies: DoNotOptimize on the running values themselves would

@@ -13,6 +13,7 @@
 // width), so packets and single rays agree bit for bit.
 #include <bit>
 #include <cstdint>
+#include <limits>
 #include <type_traits>
 
 #include "kernels/ray.h"
@@ -60,6 +61,32 @@ RAYPACK_INLINE F flip_sign(const F& x, const F& sign) {
     }
 }
 
+/// m ? a : b per lane, bit for bit the same as select(). For 4 and 8 lanes
+/// on AVX-512VL machines it is one vpternlogd on the vector mask: gcc turns
+/// xsimd's blendv into a vector-to-mask-register compare plus a masked move,
+/// and that compare (like vblendvps itself) takes a slot on the two
+/// multiply/FMA ports, which the kernels saturate; vpternlogd does not.
+template <class F>
+RAYPACK_INLINE F blend(const mask_of<F>& m, const F& a, const F& b) {
+#if defined(__AVX512VL__)
+    if constexpr (!std::is_floating_point_v<F>) {
+        if constexpr (sizeof(F) == 16) {
+            return _mm_castsi128_ps(_mm_ternarylogic_epi32(_mm_castps_si128(m), _mm_castps_si128(a),
+                                                           _mm_castps_si128(b), 0xCA));
+        } else if constexpr (sizeof(F) == 32) {
+            return _mm256_castsi256_ps(_mm256_ternarylogic_epi32(_mm256_castps_si256(m), _mm256_castps_si256(a),
+                                                                 _mm256_castps_si256(b), 0xCA));
+        }
+    }
+#endif
+    return select(m, a, b);
+}
+
+/// The least |det| a kernel divides by: the smallest normal number, so that
+/// 1/det is finite; a smaller determinant counts as zero.
+template <class F>
+inline constexpr auto kMinDet = std::numeric_limits<std::conditional_t<std::is_same_v<F, double>, double, float>>::min();
+
 }  // namespace triangle_detail
 
 /// Moeller & Trumbore, "Fast, Minimum Storage Ray/Triangle Intersection",
@@ -88,7 +115,7 @@ RAYPACK_INLINE mask_of<F> intersect_triangle_moeller(mask_of<F> valid, const Vec
     const F V = fdot(e1n, s);
     const F sign = sign_bit(det), abs_det = vabs(det);
     const F Us = flip_sign(U, sign), Vs = flip_sign(V, sign);
-    valid = valid & (abs_det > F(0)) & (Us >= F(0)) & (Vs >= F(0)) & (Us + Vs <= abs_det);
+    valid = valid & (abs_det >= F(kMinDet<F>)) & (Us >= F(0)) & (Vs >= F(0)) & (Us + Vs <= abs_det);
     if (none(valid)) return valid;
     const F T = fdot(w, ng);
     const F inv_det = F(1) / det;
@@ -100,67 +127,52 @@ RAYPACK_INLINE mask_of<F> intersect_triangle_moeller(mask_of<F> valid, const Vec
 }
 
 /// Per-ray part of the watertight test (Woop, Benthin & Wald, "Watertight
-/// Ray/Triangle Intersection", JCGT 2(1) 2013): kz = argmax |d|, kx and ky the
-/// next axes (swapped when d[kz] < 0, to keep the winding), and the shear
-/// that maps d to (0, 0, 1) in the permuted frame. The permutation is kept as
-/// masks, so it may differ per lane.
+/// Ray/Triangle Intersection", JCGT 2(1) 2013): kz = argmax |d|, kx and ky
+/// the next two axes, and the shear that maps d to (0, 0, 1) in that frame.
+/// The axis is kept as masks, so that it may differ per lane, and as a number
+/// when all lanes share it (always at width 1 and for a broadcast ray), which
+/// lets the test read the components directly instead of selecting them.
+/// The paper also swaps kx and ky when d[kz] < 0, to keep the winding for
+/// backface culling; in a two-sided test the swap negates U, V, W, det and T
+/// exactly and changes no result, so it is left out.
 template <class F>
 struct WatertightRay {
     Vec3<F> org;
-    mask_of<F> kx_x, kx_y, ky_x, ky_y, kz_x, kz_y;  // axis k is x, is y, else z
-    F neg_sx, neg_sy, sz;                            // -d[kx]/d[kz], -d[ky]/d[kz], 1/d[kz]
+    mask_of<F> kz_x, kz_y;  // kz is x, is y, else z
+    int kz = -1;            // kz of every lane, or -1 if they differ
+    F neg_sx, neg_sy, sz;   // -d[kx]/d[kz], -d[ky]/d[kz], 1/d[kz]
 };
 
+namespace triangle_detail {
+
+/// p in the frame (kx, ky, kz), kz given per lane by the masks.
 template <class F>
-RAYPACK_INLINE WatertightRay<F> make_watertight_ray(const Vec3<F>& org, const Vec3<F>& dir) {
-    const F ax = vabs(dir.x), ay = vabs(dir.y), az = vabs(dir.z);
-    const mask_of<F> zx = (ax >= ay) & (ax >= az);
-    const mask_of<F> not_zx = !zx;
-    const mask_of<F> zy = not_zx & (ay >= az);
-    const mask_of<F> not_zy = !zy;
-    const mask_of<F> zz = not_zx & not_zy;
-    const F dkz = select(zx, dir.x, select(zy, dir.y, dir.z));
-    const mask_of<F> neg = dkz < F(0), pos = !neg;
-    WatertightRay<F> r;
-    r.org = org;
-    r.kz_x = zx;
-    r.kz_y = zy;
-    // kz = x: (kx, ky) = (y, z), swapped (z, y); kz = y: (z, x) / (x, z); kz = z: (x, y) / (y, x).
-    r.kx_x = (zz & pos) | (zy & neg);
-    r.kx_y = (zx & pos) | (zz & neg);
-    r.ky_x = (zy & pos) | (zz & neg);
-    r.ky_y = (zz & pos) | (zx & neg);
-    const F dkx = select(r.kx_x, dir.x, select(r.kx_y, dir.y, dir.z));
-    const F dky = select(r.ky_x, dir.x, select(r.ky_y, dir.y, dir.z));
-    r.sz = F(1) / dkz;
-    r.neg_sx = -(dkx * r.sz);
-    r.neg_sy = -(dky * r.sz);
-    return r;
+RAYPACK_INLINE Vec3<F> to_ray_axes(const mask_of<F>& kz_x, const mask_of<F>& kz_y, const Vec3<F>& p) {
+    return {blend(kz_x, p.y, blend(kz_y, p.z, p.x)), blend(kz_x, p.z, blend(kz_y, p.x, p.y)),
+            blend(kz_x, p.x, blend(kz_y, p.y, p.z))};
 }
 
-/// The watertight test on a precomputed ray. Vertices are translated to the
-/// ray origin, permuted and sheared; the 2D edge functions U, V, W (weights
-/// of p0, p1, p2) are plain products and differences, with no fused
-/// operation, so an edge shared by two triangles gets the same value up to
-/// sign in both and no ray slips between them. Lanes where an edge function
-/// is exactly zero recompute all three in double, as the paper does
-/// (products of floats are exact in double); the lanes that need it are rare,
-/// so they are done one at a time.
+/// p in the frame (kx, ky, kz) for kz = Z in every lane.
+template <int Z, class F>
+RAYPACK_INLINE Vec3<F> to_ray_axes(const Vec3<F>& p) {
+    return {p[(Z + 1) % 3], p[(Z + 2) % 3], p[Z]};
+}
+
+/// The watertight test once the vertices a, b, c are relative to the ray
+/// origin and in the ray's axes: shear, 2D edge functions U, V, W (weights
+/// of p0, p1, p2), the sign test, and t. The edge functions are plain
+/// products and differences, with no fused operation, so an edge shared by
+/// two triangles gets the same value up to sign in both and no ray slips
+/// between them. Lanes where one is exactly zero recompute all three in
+/// double, as the paper does (products of floats are exact in double); such
+/// lanes are rare, so they are done one at a time.
 template <class F>
-RAYPACK_INLINE mask_of<F> intersect_triangle_watertight(mask_of<F> valid, const WatertightRay<F>& ray,
-                                                        const F& tnear, const F& tfar, const Vec3<F>& p0,
-                                                        const Vec3<F>& p1, const Vec3<F>& p2, F& t, F& u, F& v) {
-    const Vec3<F> a = p0 - ray.org, b = p1 - ray.org, c = p2 - ray.org;
-    auto pick = [](const Vec3<F>& p, const mask_of<F>& is_x, const mask_of<F>& is_y) {
-        return select(is_x, p.x, select(is_y, p.y, p.z));
-    };
-    const F akz = pick(a, ray.kz_x, ray.kz_y), bkz = pick(b, ray.kz_x, ray.kz_y), ckz = pick(c, ray.kz_x, ray.kz_y);
-    const F ax = vfmadd(ray.neg_sx, akz, pick(a, ray.kx_x, ray.kx_y));
-    const F ay = vfmadd(ray.neg_sy, akz, pick(a, ray.ky_x, ray.ky_y));
-    const F bx = vfmadd(ray.neg_sx, bkz, pick(b, ray.kx_x, ray.kx_y));
-    const F by = vfmadd(ray.neg_sy, bkz, pick(b, ray.ky_x, ray.ky_y));
-    const F cx = vfmadd(ray.neg_sx, ckz, pick(c, ray.kx_x, ray.kx_y));
-    const F cy = vfmadd(ray.neg_sy, ckz, pick(c, ray.ky_x, ray.ky_y));
+RAYPACK_INLINE mask_of<F> watertight_in_ray_axes(mask_of<F> valid, const WatertightRay<F>& ray, const F& tnear,
+                                                 const F& tfar, const Vec3<F>& a, const Vec3<F>& b,
+                                                 const Vec3<F>& c, F& t, F& u, F& v) {
+    const F ax = vfmadd(ray.neg_sx, a.z, a.x), ay = vfmadd(ray.neg_sy, a.z, a.y);
+    const F bx = vfmadd(ray.neg_sx, b.z, b.x), by = vfmadd(ray.neg_sy, b.z, b.y);
+    const F cx = vfmadd(ray.neg_sx, c.z, c.x), cy = vfmadd(ray.neg_sy, c.z, c.y);
     F U = cx * by - cy * bx;
     F V = ax * cy - ay * cx;
     F W = bx * ay - by * ax;
@@ -187,18 +199,58 @@ RAYPACK_INLINE mask_of<F> intersect_triangle_watertight(mask_of<F> valid, const 
             W = F::load_aligned(l[8]);
         }
     }
-    // Two-sided: a miss when the edge functions have mixed signs.
-    valid = valid & !((vmin(vmin(U, V), W) < F(0)) & (vmax(vmax(U, V), W) > F(0)));
+    // Two-sided: a hit when the edge functions do not have mixed signs.
+    valid = valid & ((vmin(vmin(U, V), W) >= F(0)) | (vmax(vmax(U, V), W) <= F(0)));
     const F det = U + V + W;
-    valid = valid & (vabs(det) > F(0));
+    valid = valid & (vabs(det) >= F(kMinDet<F>));
     if (none(valid)) return valid;
-    const F T = vfmadd(U, ray.sz * akz, vfmadd(V, ray.sz * bkz, W * (ray.sz * ckz)));
+    const F T = vfmadd(U, ray.sz * a.z, vfmadd(V, ray.sz * b.z, W * (ray.sz * c.z)));
     const F inv_det = F(1) / det;
     t = T * inv_det;
     valid = valid & (t >= tnear) & (t <= tfar);
     u = V * inv_det;
     v = W * inv_det;
     return valid;
+}
+
+}  // namespace triangle_detail
+
+template <class F>
+RAYPACK_INLINE WatertightRay<F> make_watertight_ray(const Vec3<F>& org, const Vec3<F>& dir) {
+    const F ax = vabs(dir.x), ay = vabs(dir.y), az = vabs(dir.z);
+    WatertightRay<F> r;
+    r.org = org;
+    // kz: the largest |d| component, the first one on ties.
+    r.kz_x = (ax >= ay) & (ax >= az);
+    r.kz_y = (ay > ax) & (ay >= az);
+    const std::uint32_t all = (1u << lanes_of<F>) - 1u, bx = mask_bits(r.kz_x), by = mask_bits(r.kz_y);
+    r.kz = bx == all ? 0 : by == all ? 1 : (bx | by) == 0 ? 2 : -1;
+    const Vec3<F> d = triangle_detail::to_ray_axes(r.kz_x, r.kz_y, dir);
+    r.sz = F(1) / d.z;
+    r.neg_sx = -(d.x * r.sz);
+    r.neg_sy = -(d.y * r.sz);
+    return r;
+}
+
+/// The watertight test on a precomputed ray.
+template <class F>
+RAYPACK_INLINE mask_of<F> intersect_triangle_watertight(mask_of<F> valid, const WatertightRay<F>& ray,
+                                                        const F& tnear, const F& tfar, const Vec3<F>& p0,
+                                                        const Vec3<F>& p1, const Vec3<F>& p2, F& t, F& u, F& v) {
+    using namespace triangle_detail;
+    const Vec3<F> a = p0 - ray.org, b = p1 - ray.org, c = p2 - ray.org;
+    switch (ray.kz) {
+        case 0: return watertight_in_ray_axes(valid, ray, tnear, tfar, to_ray_axes<0>(a), to_ray_axes<0>(b),
+                                              to_ray_axes<0>(c), t, u, v);
+        case 1: return watertight_in_ray_axes(valid, ray, tnear, tfar, to_ray_axes<1>(a), to_ray_axes<1>(b),
+                                              to_ray_axes<1>(c), t, u, v);
+        case 2: return watertight_in_ray_axes(valid, ray, tnear, tfar, to_ray_axes<2>(a), to_ray_axes<2>(b),
+                                              to_ray_axes<2>(c), t, u, v);
+        default:
+            return watertight_in_ray_axes(valid, ray, tnear, tfar, to_ray_axes(ray.kz_x, ray.kz_y, a),
+                                          to_ray_axes(ray.kz_x, ray.kz_y, b), to_ray_axes(ray.kz_x, ray.kz_y, c), t,
+                                          u, v);
+    }
 }
 
 template <class F>
@@ -227,7 +279,7 @@ RAYPACK_INLINE mask_of<F> intersect_triangle_plane(mask_of<F> valid, const Vec3<
     const F denom = fdot(n, dir);
     const Vec3<F> w = p0 - org;
     t = fdot(n, w) / denom;
-    valid = valid & (vabs(denom) > F(0)) & (t >= tnear) & (t <= tfar);
+    valid = valid & (vabs(denom) >= F(kMinDet<F>)) & (t >= tnear) & (t <= tfar);
     if (none(valid)) return valid;
     // q = o + t d - p0, the hit point relative to p0.
     const Vec3<F> q{vfmsub(dir.x, t, w.x), vfmsub(dir.y, t, w.y), vfmsub(dir.z, t, w.z)};

@@ -199,9 +199,12 @@ Vec3f point_on(const Tri& t, float b1, float b2) { return t.p0 + (t.p1 - t.p0) *
 
 /// A ray from a random origin through `target` (at t ~ 1/scale), with a
 /// direction of random length and, for some, an interval that ends before
-/// or starts after the target, or reaches back to -inf.
-TestRay ray_through(Gen& g, const Vec3f& target) {
-    const Vec3f org = target + g.unit() * g.pow2(-2.0f, 4.0f);
+/// or starts after the target, or reaches back to -inf. With `axis` >= 0 the
+/// direction's largest component is on that axis (with a random sign).
+TestRay ray_through(Gen& g, const Vec3f& target, int axis = -1, float sign = 1.0f) {
+    Vec3f away = g.unit();
+    if (axis >= 0) away = away * 0.5f, away[axis] = sign * g.uni(1.0f, 2.0f);
+    const Vec3f org = target + away * g.pow2(-2.0f, 4.0f);
     const float scale = g.pow2(-3.0f, 3.0f);
     TestRay r{org, (target - org) * scale};
     const float x = g.uni(0.0f, 1.0f), t_hit = 1.0f / scale;
@@ -215,15 +218,20 @@ constexpr std::size_t kRandomRays = std::size_t(1) << 20;  // per shape
 constexpr std::size_t kChunk = std::size_t(1) << 16;       // pairs generated at a time
 
 /// Chunk `k` of the K-rays shape: 4096 random triangles, 16 rays each, aimed
-/// at barycentrics in [-0.1, 1]^2 (about 40% inside).
+/// at barycentrics in [-0.1, 1]^2 (about 40% inside). Every other group of
+/// 16 shares the axis of its rays' largest direction component (as coherent
+/// packets do; the watertight test then takes its uniform-axis path), the
+/// others have random directions (lanes with different axes).
 void packet_chunk(std::size_t k, Cases& c) {
     c.clear();
     Gen g(unsigned(1000 + k));
     for (std::size_t i = 0; i < kChunk / 16; ++i) {
         const Tri tri = random_triangle(g);
+        const int axis = i % 2 ? g.pick(3) : -1;
+        const float sign = g.pick(2) ? 1.0f : -1.0f;
         for (int r = 0; r < 16; ++r) {
             const float b1 = g.uni(-0.1f, 1.0f), b2 = g.uni(-0.1f, 1.0f);
-            c.add(ray_through(g, point_on(tri, b1, b2)), tri);
+            c.add(ray_through(g, point_on(tri, b1, b2), axis, sign), tri);
         }
     }
 }
@@ -624,8 +632,7 @@ Analysis analyse(TriangleMethod m, const TestRay& r, const Tri& tri) {
     if (m == TriangleMethod::Watertight) {
         const Vec3d ad = abs3(d);
         const int kz = ad.x >= ad.y && ad.x >= ad.z ? 0 : ad.y >= ad.z ? 1 : 2;
-        int kx = (kz + 1) % 3, ky = (kx + 1) % 3;
-        if (d[kz] < 0) std::swap(kx, ky);
+        const int kx = (kz + 1) % 3, ky = (kz + 2) % 3;
         const double sx = d[kx] / d[kz], sy = d[ky] / d[kz], sz = 1.0 / d[kz];
         const Vec3d P[3] = {p0 - o, p1 - o, p2 - o};
         double x[3], y[3], z[3], xa[3], ya[3];
