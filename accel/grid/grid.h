@@ -19,12 +19,12 @@ struct GridConfig {
     /// Visual Computer 1988; Ize, Shirley & Parker, "Grid Creation Strategies
     /// for Efficient Ray Tracing", RT 2007: O(N) cells is optimal, with a
     /// constant that depends on the scene and on the cost of a cell step
-    /// against a primitive test). 16 is the best geometric mean of raypack's
-    /// own sweep over the shared scenes (lambda 4 to 24, camera rays, one
-    /// ray at a time): it trades a little on compact meshes (tetra, mount,
-    /// bunny, best near 4) for much on dense clusters in large boxes (balls,
-    /// tree).
-    float lambda = 16.0f;
+    /// against a primitive test). 24 from raypack's own sweep over the shared
+    /// scenes (lambda 4 to 32, camera rays, one ray at a time): the geometric
+    /// mean of the speed relative to bvh2 is flat from 16 to 32; compact
+    /// meshes (mount, teapot, bunny) prefer 8-12, dense clusters in a large
+    /// box (balls, tree) want as many cells as memory allows.
+    float lambda = 24.0f;
     /// Upper bounds that keep absurd inputs from exhausting memory: the cell
     /// count (64M cells = 256 MiB of ranges), and the reference count (the
     /// resolution is halved per axis until the references fit).
