@@ -261,10 +261,12 @@ RAYPACK_INLINE mask_of<F> intersect_triangle_watertight(mask_of<F> valid, const 
 }
 
 /// Plane intersection followed by an inside test: t from the plane equation,
-/// then the hit point's barycentrics against the edge planes n1 = e2 x n / |n|^2
-/// and n2 = n x e1 / |n|^2, which depend on the triangle alone (Havel & Herout,
-/// "Yet Faster Ray-Triangle Intersection (Using SSE4)", IEEE TVCG 2010).
-/// A ray parallel to the plane, or a degenerate triangle, is a miss.
+/// then the hit point's barycentrics against the edge planes e2 x n and
+/// n x e1, which depend on the triangle alone (Havel & Herout, "Yet Faster
+/// Ray-Triangle Intersection (Using SSE4)", IEEE TVCG 2010, who store them
+/// divided by |n|^2; here the inside test compares the undivided values
+/// with |n|^2, and u, v are divided once at the end). A ray parallel to the
+/// plane, or a degenerate triangle, is a miss.
 template <class F>
 RAYPACK_INLINE mask_of<F> intersect_triangle_plane(mask_of<F> valid, const Vec3<F>& org, const Vec3<F>& dir,
                                                    const F& tnear, const F& tfar, const Vec3<F>& p0,
@@ -273,19 +275,21 @@ RAYPACK_INLINE mask_of<F> intersect_triangle_plane(mask_of<F> valid, const Vec3<
     const Vec3<F> e1 = p1 - p0;
     const Vec3<F> e2 = p2 - p0;
     const Vec3<F> n = fcross(e1, e2);
-    const F inv_nn = F(1) / fdot(n, n);
-    const Vec3<F> n1 = fcross(e2, n) * inv_nn;
-    const Vec3<F> n2 = fcross(n, e1) * inv_nn;
+    const F nn = fdot(n, n);
+    const Vec3<F> n1 = fcross(e2, n), n2 = fcross(n, e1);
     const F denom = fdot(n, dir);
     const Vec3<F> w = p0 - org;
     t = fdot(n, w) / denom;
     valid = valid & (vabs(denom) >= F(kMinDet<F>)) & (t >= tnear) & (t <= tfar);
     if (none(valid)) return valid;
-    // q = o + t d - p0, the hit point relative to p0.
+    // q = o + t d - p0, the hit point relative to p0; q = U e1 + V e2 with
+    // U = q . n1 / |n|^2, V = q . n2 / |n|^2.
     const Vec3<F> q{vfmsub(dir.x, t, w.x), vfmsub(dir.y, t, w.y), vfmsub(dir.z, t, w.z)};
-    u = fdot(q, n1);
-    v = fdot(q, n2);
-    valid = valid & (u >= F(0)) & (v >= F(0)) & (u + v <= F(1));
+    const F U = fdot(q, n1), V = fdot(q, n2);
+    valid = valid & (U >= F(0)) & (V >= F(0)) & (U + V <= nn);
+    const F inv_nn = F(1) / nn;
+    u = U * inv_nn;
+    v = V * inv_nn;
     return valid;
 }
 

@@ -672,18 +672,17 @@ Analysis analyse(TriangleMethod m, const TestRay& r, const Tri& tri) {
         const double T = dot(n, w), TA = dot(na, abs3(w));
         a.t = T / a.det;
         a.et = (TA + std::fabs(a.t) * a.edet) / std::fabs(a.det) + std::fabs(a.t);
-        // u = q . n1, v = q . n2 with q = d t - w, n1 = (e2 x n)/|n|^2, n2 = (n x e1)/|n|^2.
+        // U = q . n1, V = q . n2 with q = d t - w, n1 = e2 x n, n2 = n x e1,
+        // tested against |n|^2: u = U / |n|^2, v = V / |n|^2.
         const double nn = dot(n, n);
-        const Vec3d n1 = cross(e2, n) / nn, n2 = cross(n, e1) / nn;
+        const Vec3d n1 = cross(e2, n), n2 = cross(n, e1);
         const Vec3d q = d * a.t - w;
         const Vec3d qa = abs3(d) * (std::fabs(a.t) + a.et) + abs3(w);
-        // Error of n1, n2: their cross products (terms bounded by |e| x (|e| x |e|)) and |n|^2.
-        const Vec3d n1a = (abs_cross(e2, na) + abs3(n1) * (2.0 * dot(na, abs3(n)))) / nn;
-        const Vec3d n2a = (abs_cross(na, e1) + abs3(n2) * (2.0 * dot(na, abs3(n)))) / nn;
-        a.b[1] = dot(q, n1), a.b[2] = dot(q, n2), a.b[0] = 1.0 - a.b[1] - a.b[2];
-        a.eb[1] = dot(qa, abs3(n1)) + dot(abs3(q), n1a);
-        a.eb[2] = dot(qa, abs3(n2)) + dot(abs3(q), n2a);
-        a.eb[0] = a.eb[1] + a.eb[2] + 1.0;
+        const Vec3d n1a = abs_cross(e2, na), n2a = abs_cross(na, e1);  // n1, n2 from the rounded n
+        a.b[1] = dot(q, n1) / nn, a.b[2] = dot(q, n2) / nn, a.b[0] = 1.0 - a.b[1] - a.b[2];
+        a.eb[1] = (dot(qa, abs3(n1)) + dot(abs3(q), n1a)) / nn;
+        a.eb[2] = (dot(qa, abs3(n2)) + dot(abs3(q), n2a)) / nn;
+        a.eb[0] = a.eb[1] + a.eb[2] + 2.0 * dot(na, abs3(n)) / nn;
     }
     // How close the ray passes to the triangle's boundary: the least distance
     // between the ray's line and an edge segment, in units of eps times the
