@@ -98,8 +98,9 @@ inline constexpr auto kMinDet = std::numeric_limits<std::conditional_t<std::is_s
 /// with ng = e2 x e1 per triangle and s = d x (p0 - o) per ray: one cross
 /// product per test instead of two. Two-sided: the edge tests compare the
 /// undivided U, V (sign of det folded in) against |det|, and the one
-/// division comes last, for the lanes that passed them. A zero determinant
-/// (ray parallel to the plane, degenerate triangle) is a miss.
+/// division comes last, for the lanes that passed them. A determinant below
+/// the smallest normal float (ray parallel to the plane, degenerate
+/// triangle) is a miss.
 template <class F>
 RAYPACK_INLINE mask_of<F> intersect_triangle_moeller(mask_of<F> valid, const Vec3<F>& org, const Vec3<F>& dir,
                                                      const F& tnear, const F& tfar, const Vec3<F>& p0,
