@@ -1,10 +1,10 @@
 #include "accel/accel.h"
 
-#include <array>
 #include <stdexcept>
 
 #include "accel/brute/brute_force.h"
 #include "accel/bvh/bvh2_accel.h"
+#include "accel/bvh/wide_bvh_accel.h"
 #include "accel/grid/grid_accel.h"
 #ifdef RAYPACK_HAVE_EMBREE
 #include "accel/embree/embree_accel.h"
@@ -13,11 +13,20 @@
 namespace raypack {
 
 std::span<const char* const> accel_kinds() {
-#ifdef RAYPACK_HAVE_EMBREE
-    static constexpr std::array<const char*, 4> kinds = {"bvh2", "grid", "brute", "embree"};
-#else
-    static constexpr std::array<const char*, 3> kinds = {"bvh2", "grid", "brute"};
+    static constexpr const char* kinds[] = {
+        "bvh2",
+#if defined(__SSE4_2__)
+        "bvh4",
 #endif
+#if defined(__AVX2__)
+        "bvh8",
+#endif
+        "grid",
+        "brute",
+#ifdef RAYPACK_HAVE_EMBREE
+        "embree",
+#endif
+    };
     return kinds;
 }
 
@@ -32,6 +41,12 @@ std::string accel_kinds_list() {
 
 std::unique_ptr<Accel> build_accel(const Scene& scene, const AccelConfig& config) {
     if (config.kind == "bvh2") return std::make_unique<Bvh2Accel>(scene, config);
+#if defined(__SSE4_2__)
+    if (config.kind == "bvh4") return std::make_unique<Bvh4Accel>(scene, config);
+#endif
+#if defined(__AVX2__)
+    if (config.kind == "bvh8") return std::make_unique<Bvh8Accel>(scene, config);
+#endif
     if (config.kind == "grid") return std::make_unique<GridAccel>(scene, config);
     if (config.kind == "brute") return std::make_unique<BruteForce>(scene, config.kernels);
 #ifdef RAYPACK_HAVE_EMBREE

@@ -1,0 +1,86 @@
+#pragma once
+// An N-wide BVH (N = 4 or 8) whose child boxes are stored as SoA, so that one
+// ray tests all N children with one SIMD slab test (Dammertz, Hanika, Keller,
+// "Shallow Bounding Volume Hierarchies for Fast SIMD Ray Tracing of Incoherent
+// Rays", EGSR 2008; Ernst & Greiner, "Multi Bounding Volume Hierarchies",
+// RT 2008; Wald, Benthin, Boulos, "Getting Rid of Packets", RT 2008). Leaves
+// are runs of SoA blocks of M primitives of one kind (accel/bvh/leaf_blocks.h).
+#include <cstdint>
+#include <vector>
+
+#include <xsimd/memory/xsimd_aligned_allocator.hpp>
+
+#include "accel/bvh/leaf_blocks.h"
+#include "kernels/aabb.h"
+
+namespace raypack {
+
+/// A child slot: an inner node index, or a leaf (top bit set) naming a run of
+/// leaf blocks. Leaf bits: 30..29 kind (WideLeafKind), 28..26 blocks - 1,
+/// 25..0 first block (for kind Mixed: the index into WideBvh::mixed).
+namespace wide_child {
+inline constexpr std::uint32_t kLeafBit = 0x80000000u;
+inline constexpr std::uint32_t kEmpty = 0xFFFFFFFFu;  ///< unused slot (its box is empty)
+inline constexpr int kKindShift = 29, kCountShift = 26;
+inline constexpr std::uint32_t kIndexMask = (1u << kCountShift) - 1u;
+inline constexpr std::uint32_t kMaxBlocks = 8;
+
+RAYPACK_INLINE bool is_leaf(std::uint32_t c) { return (c & kLeafBit) != 0; }
+RAYPACK_INLINE LeafKind kind(std::uint32_t c) { return LeafKind((c >> kKindShift) & 3u); }
+RAYPACK_INLINE std::uint32_t blocks(std::uint32_t c) { return ((c >> kCountShift) & 7u) + 1u; }
+RAYPACK_INLINE std::uint32_t first(std::uint32_t c) { return c & kIndexMask; }
+inline std::uint32_t make_leaf(LeafKind k, std::uint32_t first_block, std::uint32_t block_count) {
+    return kLeafBit | (std::uint32_t(k) << kKindShift) | ((block_count - 1u) << kCountShift) | first_block;
+}
+}  // namespace wide_child
+
+/// N child boxes as SoA, rows lo_x, lo_y, lo_z, hi_x, hi_y, hi_z, then the N
+/// child slots. An unused slot has the empty box lo = +inf, hi = -inf, which
+/// the ordered slab test never enters. Rows are addressed by number so that a
+/// ray picks its near and far planes per axis once (row a or a + 3).
+template <int N>
+struct alignas(64) WideNode {
+    float bounds[6][N];
+    std::uint32_t child[N];
+
+    Box3f box(int i) const {
+        return {{bounds[0][i], bounds[1][i], bounds[2][i]}, {bounds[3][i], bounds[4][i], bounds[5][i]}};
+    }
+    void set_box(int i, const Box3f& b) {
+        for (int a = 0; a < 3; ++a) {
+            bounds[a][i] = b.lo[a];
+            bounds[a + 3][i] = b.hi[a];
+        }
+    }
+};  // total: N = 4: 112 bytes, padded to 128 (two cache lines); N = 8: 224, padded to 256
+static_assert(sizeof(WideNode<4>) == 128 && sizeof(WideNode<8>) == 256);
+
+/// A leaf holding several kinds, or more blocks than a child slot can name:
+/// a run of blocks per kind (indexed by LeafKind; count 0 if none).
+struct MixedLeaf {
+    std::uint32_t first[3];
+    std::uint32_t count[3];
+};  // total: 24 bytes
+
+template <class T>
+using AlignedVector = std::vector<T, xsimd::aligned_allocator<T, 64>>;
+
+template <int N, int M>
+struct WideBvh {
+    AlignedVector<WideNode<N>> nodes;  ///< root at 0; empty for an empty scene
+    AlignedVector<TriangleBlock<M>> triangles;
+    AlignedVector<SphereBlock<M>> spheres;
+    AlignedVector<ConeBlock<M>> cones;
+    std::vector<MixedLeaf> mixed;
+    TriangleLayout triangle_layout = TriangleLayout::Edges;
+    int depth = 0;
+    std::size_t leaves = 0;
+
+    std::size_t bytes() const {
+        return nodes.size() * sizeof(WideNode<N>) + triangles.size() * sizeof(TriangleBlock<M>) +
+               spheres.size() * sizeof(SphereBlock<M>) + cones.size() * sizeof(ConeBlock<M>) +
+               mixed.size() * sizeof(MixedLeaf);
+    }
+};
+
+}  // namespace raypack

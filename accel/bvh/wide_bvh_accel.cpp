@@ -1,0 +1,99 @@
+#include "accel/bvh/wide_bvh_accel.h"
+
+#include <chrono>
+#include <vector>
+
+#include "accel/bvh/binned_sah_builder.h"
+
+namespace raypack {
+
+template <int N, int M, NodeTest Test>
+CollapseConfig WideBvhAccel<N, M, Test>::collapse_config(const AccelConfig& config) {
+    CollapseConfig c;
+    // One wide node test costs about one block test (both are one SIMD
+    // kernel call); config.traversal_cost / intersection_cost keep their
+    // meaning as the ratio of the two.
+    c.node_cost = config.traversal_cost;
+    c.block_cost = config.intersection_cost;
+    c.max_leaf_prims = 2 * M;
+    c.triangle_layout =
+        config.kernels.triangle == TriangleMethod::Moeller ? TriangleLayout::Edges : TriangleLayout::Vertices;
+    return c;
+}
+
+template <int N, int M, NodeTest Test>
+WideBvhAccel<N, M, Test>::WideBvhAccel(const Scene& scene, const AccelConfig& config)
+    : WideBvhAccel(scene, config, collapse_config(config)) {}
+
+template <int N, int M, NodeTest Test>
+WideBvhAccel<N, M, Test>::WideBvhAccel(const Scene& scene, const AccelConfig& config, const CollapseConfig& collapse)
+    : kernels_(config.kernels) {
+    const auto start = std::chrono::steady_clock::now();
+    const std::size_t n = scene.primitive_count();
+    std::vector<Box3f> boxes(n);
+    std::vector<Vec3f> centers(n);
+    for (std::uint32_t i = 0; i < n; ++i) {
+        boxes[i] = primitive_bounds(scene, i);
+        centers[i] = boxes[i].center();
+    }
+    BinnedSahConfig bc;
+    bc.bins = config.sah_bins;
+    bc.max_leaf_size = config.max_leaf_size;
+    bc.traversal_cost = config.traversal_cost;
+    bc.intersection_cost = config.intersection_cost;
+    const Bvh2 binary = build_binned_sah(boxes, centers, bc);
+    CollapseConfig cc = collapse;
+    cc.triangle_layout = collapse_config(config).triangle_layout;  // must match the kernel that runs
+    bvh_ = collapse_bvh<N, M>(binary, scene, cc);
+    const auto stop = std::chrono::steady_clock::now();
+    stats_.name = N == 4 ? "bvh4" : "bvh8";
+    stats_.builder = "binned";
+    stats_.build_ms = std::chrono::duration<double, std::milli>(stop - start).count();
+    stats_.nodes = bvh_.nodes.size();
+    stats_.leaves = bvh_.leaves;
+    stats_.depth = bvh_.depth;
+    stats_.bytes = bvh_.bytes();
+    stats_.sah_cost = sah_cost(bvh_, config.traversal_cost, config.intersection_cost);
+}
+
+template <int N, int M, NodeTest Test>
+template <bool AnyHit, class Out>
+void WideBvhAccel<N, M, Test>::trace(std::span<const Rayf> rays, Out&& out) const {
+    auto run = [&]<TriangleMethod TM>() {
+        for (std::size_t i = 0; i < rays.size(); ++i) {
+            Hitf hit;
+            const bool any = trace_wide<N, M, TM, Test, AnyHit>(bvh_, kernels_.sphere, rays[i], hit);
+            out(i, any, hit);
+        }
+    };
+    switch (kernels_.triangle) {
+        case TriangleMethod::Moeller: return run.template operator()<TriangleMethod::Moeller>();
+        case TriangleMethod::Watertight: return run.template operator()<TriangleMethod::Watertight>();
+        case TriangleMethod::Plane: return run.template operator()<TriangleMethod::Plane>();
+    }
+}
+
+template <int N, int M, NodeTest Test>
+void WideBvhAccel<N, M, Test>::intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const {
+    trace<false>(rays, [&](std::size_t i, bool, const Hitf& hit) { hits[i] = hit; });
+}
+
+template <int N, int M, NodeTest Test>
+void WideBvhAccel<N, M, Test>::occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const {
+    trace<true>(rays, [&](std::size_t i, bool any, const Hitf&) { occluded[i] = any ? 1 : 0; });
+}
+
+#if defined(__SSE4_2__)
+template class WideBvhAccel<4, 4>;
+#endif
+#if defined(__AVX2__)
+template class WideBvhAccel<8, 4>;
+template class WideBvhAccel<8, 8>;
+template class WideBvhAccel<4, 8>;
+template class WideBvhAccel<8, 4, NodeTest::Plain>;
+template class WideBvhAccel<8, 4, NodeTest::Robust>;
+template class WideBvhAccel<4, 4, NodeTest::Plain>;
+template class WideBvhAccel<4, 4, NodeTest::Robust>;
+#endif
+
+}  // namespace raypack

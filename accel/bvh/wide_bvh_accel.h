@@ -1,0 +1,43 @@
+#pragma once
+// BVH4 and BVH8: the binned-SAH BVH2 collapsed into N-wide nodes with SoA
+// child boxes and SoA leaf blocks of M primitives, traced one ray at a time
+// with SIMD node tests (accel/bvh/wide_traversal.h).
+#include "accel/accel.h"
+#include "accel/bvh/collapse.h"
+#include "accel/bvh/wide_traversal.h"
+
+namespace raypack {
+
+template <int N, int M, NodeTest Test = NodeTest::Ordered>
+class WideBvhAccel final : public Accel {
+public:
+    /// Builds over every primitive of `scene` (which must outlive this).
+    /// `collapse` overrides the leaf costs and size the config implies.
+    WideBvhAccel(const Scene& scene, const AccelConfig& config);
+    WideBvhAccel(const Scene& scene, const AccelConfig& config, const CollapseConfig& collapse);
+    void intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const override;
+    void occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override;
+    const AccelStats& stats() const override { return stats_; }
+    const WideBvh<N, M>& bvh() const { return bvh_; }
+
+    /// The collapse settings a config implies (N-wide node and M-wide block costs).
+    static CollapseConfig collapse_config(const AccelConfig& config);
+
+private:
+    template <bool AnyHit, class Out>
+    void trace(std::span<const Rayf> rays, Out&& out) const;
+
+    KernelChoice kernels_;
+    WideBvh<N, M> bvh_;
+    AccelStats stats_;
+};
+
+/// The configurations `--accel bvh4` and `--accel bvh8` run.
+#if defined(__SSE4_2__)
+using Bvh4Accel = WideBvhAccel<4, 4>;
+#endif
+#if defined(__AVX2__)
+using Bvh8Accel = WideBvhAccel<8, 4>;
+#endif
+
+}  // namespace raypack
