@@ -11,11 +11,16 @@ public:
     void intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const override;
     void occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override;
     const AccelStats& stats() const override { return stats_; }
+    bool supports_packet(int width) const override;
+    void intersect_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const override;
+    void occluded_packets(int width, std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override;
     const Bvh2& bvh() const { return bvh_; }
 
 private:
     template <bool AnyHit>
     bool trace(Rayf& ray, Hitf& hit) const;
+    template <bool AnyHit>
+    void trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const;
 
     const Scene* scene_;
     KernelChoice kernels_;
