@@ -102,15 +102,34 @@ inline constexpr auto kMinDet = std::numeric_limits<std::conditional_t<std::is_s
 /// the smallest normal float (ray parallel to the plane, degenerate
 /// triangle) is a miss.
 template <class F>
+RAYPACK_INLINE mask_of<F> intersect_triangle_moeller_edges(mask_of<F> valid, const Vec3<F>& org,
+                                                           const Vec3<F>& dir, const F& tnear, const F& tfar,
+                                                           const Vec3<F>& p0, const Vec3<F>& e1n,
+                                                           const Vec3<F>& e2, const Vec3<F>& ng, F& t, F& u,
+                                                           F& v);
+
+template <class F>
 RAYPACK_INLINE mask_of<F> intersect_triangle_moeller(mask_of<F> valid, const Vec3<F>& org, const Vec3<F>& dir,
                                                      const F& tnear, const F& tfar, const Vec3<F>& p0,
                                                      const Vec3<F>& p1, const Vec3<F>& p2, F& t, F& u, F& v) {
-    using namespace triangle_detail;
     const Vec3<F> e1n = p0 - p1;  // -e1
     const Vec3<F> e2 = p2 - p0;
-    const Vec3<F> ng = fcross(e1n, e2);  // e2 x e1
-    const Vec3<F> w = p0 - org;          // -tvec
-    const Vec3<F> s = fcross(dir, w);    // tvec x d
+    const Vec3<F> ng = triangle_detail::fcross(e1n, e2);  // e2 x e1
+    return intersect_triangle_moeller_edges<F>(valid, org, dir, tnear, tfar, p0, e1n, e2, ng, t, u, v);
+}
+
+/// The per-ray part of intersect_triangle_moeller, for triangles stored with
+/// their edges e1n = p0 - p1, e2 = p2 - p0 and ng = fcross(e1n, e2)
+/// (triangle_detail::fcross, so that the results are the same bit for bit).
+template <class F>
+RAYPACK_INLINE mask_of<F> intersect_triangle_moeller_edges(mask_of<F> valid, const Vec3<F>& org,
+                                                           const Vec3<F>& dir, const F& tnear, const F& tfar,
+                                                           const Vec3<F>& p0, const Vec3<F>& e1n,
+                                                           const Vec3<F>& e2, const Vec3<F>& ng, F& t, F& u,
+                                                           F& v) {
+    using namespace triangle_detail;
+    const Vec3<F> w = p0 - org;        // -tvec
+    const Vec3<F> s = fcross(dir, w);  // tvec x d
     const F det = fdot(dir, ng);
     const F U = fdot(e2, s);
     const F V = fdot(e1n, s);
