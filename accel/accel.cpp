@@ -6,6 +6,7 @@
 #include "accel/bvh/bvh2_accel.h"
 #include "accel/bvh/wide_bvh_accel.h"
 #include "accel/grid/grid_accel.h"
+#include "accel/kdtree/kdtree_accel.h"
 #ifdef RAYPACK_HAVE_EMBREE
 #include "accel/embree/embree_accel.h"
 #endif
@@ -22,6 +23,7 @@ std::span<const char* const> accel_kinds() {
         "bvh8",
 #endif
         "grid",
+        "kdtree",
         "brute",
 #ifdef RAYPACK_HAVE_EMBREE
         "embree",
@@ -48,6 +50,7 @@ std::unique_ptr<Accel> build_accel(const Scene& scene, const AccelConfig& config
     if (config.kind == "bvh8") return std::make_unique<Bvh8Accel>(scene, config);
 #endif
     if (config.kind == "grid") return std::make_unique<GridAccel>(scene, config);
+    if (config.kind == "kdtree") return std::make_unique<KdTreeAccel>(scene, config);
     if (config.kind == "brute") return std::make_unique<BruteForce>(scene, config.kernels);
 #ifdef RAYPACK_HAVE_EMBREE
     if (config.kind == "embree") return std::make_unique<EmbreeAccel>(scene);

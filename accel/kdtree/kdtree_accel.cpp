@@ -1,0 +1,192 @@
+#include "accel/kdtree/kdtree_accel.h"
+
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "accel/kdtree/kdtree_build.h"
+#include "accel/kdtree/kdtree_packet.h"
+#include "accel/kdtree/kdtree_ray_interval.h"
+#include "accel/kdtree/primitive_clipper.h"
+
+namespace raypack {
+
+KdTreeAccel::KdTreeAccel(const Scene& scene, const AccelConfig& config, const KdTreeConfig& kd_config)
+    : scene_(&scene), kernels_(config.kernels) {
+    const auto start = std::chrono::steady_clock::now();
+    const std::size_t n = scene.primitive_count();
+    std::vector<Box3f> boxes(n);
+    tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) { boxes[i] = primitive_bounds(scene, std::uint32_t(i)); });
+    const PrimitiveClipper clipper{&scene, kd_config.perfect_splits};
+    const KdClipFn clip = [&](std::uint32_t prim, const Box3f& voxel, Box3f& out) {
+        return clipper.clip(prim, voxel, out);
+    };
+    tree_ = build_kdtree(boxes, clip, kd_config);
+    const auto stop = std::chrono::steady_clock::now();
+    stats_.name = "kdtree";
+    stats_.builder = "sah-nlogn";
+    stats_.build_ms = std::chrono::duration<double, std::milli>(stop - start).count();
+    stats_.nodes = tree_.nodes.size();
+    stats_.leaves = tree_.leaves;
+    stats_.bytes = tree_.bytes();
+    stats_.depth = tree_.depth;
+    stats_.sah_cost = tree_.sah_cost;
+}
+
+double KdTreeAccel::references_per_primitive() const {
+    const std::size_t n = scene_->primitive_count();
+    return n ? double(tree_.references) / double(n) : 0.0;
+}
+
+// Front-to-back traversal with a stack of far children and their intervals
+// (Havran's TA_B; pbrt's KdTreeAggregate::Intersect). Each split plane is
+// widened by the tree's margin: the below child is visited where the ray is
+// at most `margin` above the plane, the above child where it is at most
+// `margin` below, so that neither rounding of the plane distance nor a hit
+// the kernels report just across a plane is lost; a ray in a plane (its
+// direction component +-0, reciprocal() clamps it) visits both children.
+// Any hit the kernels report is genuine and shrinks tfar; a node is skipped
+// once its interval starts past tfar.
+template <bool AnyHit, bool Counting>
+bool KdTreeAccel::trace(Rayf& ray, Hitf& hit, KdRayCounters* counters) const {
+    if constexpr (Counting) ++counters->rays;
+    if (tree_.empty()) return false;
+    const Vec3f rdir = reciprocal(ray.dir);
+    float tmin, tmax;
+    if (!kd_ray_interval<float>(true, ray.org, rdir, ray.tnear, ray.tfar, tree_.bounds, tree_.margin, tmin, tmax))
+        return false;
+    const float slack[3] = {tree_.margin * std::fabs(rdir.x), tree_.margin * std::fabs(rdir.y),
+                            tree_.margin * std::fabs(rdir.z)};
+    const PrimitiveIntersector<float> isect{scene_, kernels_};
+    const KdNode* nodes = tree_.nodes.data();
+    struct Todo {
+        std::uint32_t node;
+        float tmin, tmax;
+    };
+    Todo stack[kKdMaxDepth + 1];
+    int sp = 0;
+    std::uint32_t current = 0;
+    bool found = false;
+    for (;;) {
+        const KdNode node = nodes[current];
+        if constexpr (Counting) ++counters->nodes_visited;
+        if (!node.is_leaf()) {
+            const int a = node.axis();
+            const float t_split = (node.split() - ray.org[a]) * rdir[a];
+            const float near_end = t_split + slack[a], far_start = t_split - slack[a];
+            const bool below_first = rdir[a] >= 0.0f;
+            const std::uint32_t near = below_first ? current + 1 : node.above_child();
+            const std::uint32_t far = below_first ? node.above_child() : current + 1;
+            const bool visit_near = near_end >= tmin, visit_far = far_start <= tmax;
+            if (visit_near && visit_far) {
+                stack[sp++] = {far, std::max(tmin, far_start), tmax};
+                current = near;
+                tmax = std::min(tmax, near_end);
+            } else if (visit_near) {
+                current = near;
+                tmax = std::min(tmax, near_end);
+            } else {
+                current = far;
+                tmin = std::max(tmin, far_start);
+            }
+            continue;
+        }
+        const std::uint32_t count = node.prim_count();
+        if constexpr (Counting) {
+            ++counters->leaves_visited;
+            counters->prim_tests += count;
+        }
+        const std::uint32_t* prims = tree_.leaf_prims(nodes[current]);
+        for (std::uint32_t k = 0; k < count; ++k) {
+            const Hitf before = hit;
+            if (isect.intersect(prims[k], ray, hit)) {
+                found = true;
+                if constexpr (AnyHit) return true;
+                // The kernels accept t == tfar, so of several primitives at
+                // exactly the same t the last one tested would win: keep the
+                // lowest number instead, which makes the answer independent
+                // of the visiting order (packets order nodes by one lane).
+                if (hit.t == before.t && before.prim < prims[k]) hit = before;
+            }
+        }
+        // Pop the next node the ray reaches before its closest hit so far.
+        for (;;) {
+            if (sp == 0) return found;
+            const Todo& t = stack[--sp];
+            if (t.tmin <= ray.tfar) {
+                current = t.node;
+                tmin = t.tmin;
+                tmax = t.tmax;
+                break;
+            }
+        }
+    }
+}
+
+void KdTreeAccel::intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const {
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        Rayf ray = rays[i];
+        Hitf hit;
+        trace<false, false>(ray, hit, nullptr);
+        hits[i] = hit;
+    }
+}
+
+void KdTreeAccel::occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const {
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        Rayf ray = rays[i];
+        Hitf hit;
+        occluded[i] = trace<true, false>(ray, hit, nullptr) ? 1 : 0;
+    }
+}
+
+Hitf KdTreeAccel::intersect_counting(const Rayf& ray_in, KdRayCounters& counters) const {
+    Rayf ray = ray_in;
+    Hitf hit;
+    trace<false, true>(ray, hit, &counters);
+    return hit;
+}
+
+bool KdTreeAccel::occluded_counting(const Rayf& ray_in, KdRayCounters& counters) const {
+    Rayf ray = ray_in;
+    Hitf hit;
+    return trace<true, true>(ray, hit, &counters);
+}
+
+bool KdTreeAccel::supports_packet(int width) const {
+    return width == 1 || (width == 4 && kWidthCompiled<4>) || (width == 8 && kWidthCompiled<8>) ||
+           (width == 16 && kWidthCompiled<16>);
+}
+
+template <bool AnyHit>
+void KdTreeAccel::trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
+    switch (width) {
+#if defined(__SSE4_2__)
+        case 4: return kdtree_trace_packets<4, AnyHit>(tree_, *scene_, kernels_, rays, hits);
+#endif
+#if defined(__AVX2__)
+        case 8: return kdtree_trace_packets<8, AnyHit>(tree_, *scene_, kernels_, rays, hits);
+#endif
+#if defined(__AVX512BW__)
+        case 16: return kdtree_trace_packets<16, AnyHit>(tree_, *scene_, kernels_, rays, hits);
+#endif
+        default: throw std::invalid_argument("kdtree: packet width " + std::to_string(width) + " is not compiled in");
+    }
+}
+
+void KdTreeAccel::intersect_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
+    if (width == 1) return intersect(rays, hits);
+    trace_packets<false>(width, rays, hits);
+}
+
+void KdTreeAccel::occluded_packets(int width, std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const {
+    if (width == 1) return this->occluded(rays, occluded);
+    std::vector<Hitf> hits(rays.size());
+    trace_packets<true>(width, rays, hits);
+    for (std::size_t i = 0; i < rays.size(); ++i) occluded[i] = hits[i].found() ? 1 : 0;
+}
+
+}  // namespace raypack
