@@ -7,6 +7,7 @@
 #include "accel/bvh/wide_bvh_accel.h"
 #include "accel/grid/grid_accel.h"
 #include "accel/kdtree/kdtree_accel.h"
+#include "accel/octree/octree_accel.h"
 #ifdef RAYPACK_HAVE_EMBREE
 #include "accel/embree/embree_accel.h"
 #endif
@@ -24,6 +25,7 @@ std::span<const char* const> accel_kinds() {
 #endif
         "grid",
         "kdtree",
+        "octree",
         "brute",
 #ifdef RAYPACK_HAVE_EMBREE
         "embree",
@@ -51,6 +53,7 @@ std::unique_ptr<Accel> build_accel(const Scene& scene, const AccelConfig& config
 #endif
     if (config.kind == "grid") return std::make_unique<GridAccel>(scene, config);
     if (config.kind == "kdtree") return std::make_unique<KdTreeAccel>(scene, config);
+    if (config.kind == "octree") return std::make_unique<OctreeAccel>(scene, config);
     if (config.kind == "brute") return std::make_unique<BruteForce>(scene, config.kernels);
 #ifdef RAYPACK_HAVE_EMBREE
     if (config.kind == "embree") return std::make_unique<EmbreeAccel>(scene);

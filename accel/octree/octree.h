@@ -1,0 +1,51 @@
+#pragma once
+// An adaptive octree over the scene's bounding cube: inner nodes have eight
+// children stored consecutively, leaves are ranges of one array of primitive
+// references. The node boxes are implicit (the cube halved at every level),
+// which is what the parametric traversal of Revelles, Urena & Lastra ("An
+// Efficient Parametric Algorithm for Octree Traversal", WSCG 2000) needs.
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "kernels/aabb.h"
+
+namespace raypack {
+
+/// Deepest level any build goes to (the traversal stacks are this deep).
+inline constexpr int kOctreeMaxDepth = 24;
+
+struct OctreeConfig {
+    /// Subdivide while a node holds more than this many references ...
+    int leaf_size = 8;
+    /// ... and is shallower than this (the root is depth 0; at most kOctreeMaxDepth).
+    int max_depth = 12;
+    /// Place triangles by exact triangle-box overlap and spheres by their
+    /// distance to the box; false places every primitive by its box only.
+    bool exact_overlap = true;
+};
+
+/// 8 bytes. Inner: `first` is the index of child 0, the eight children follow
+/// in the order of Revelles et al. (bit 4 = upper half in x, 2 = y, 1 = z).
+/// Leaf: refs[first .. first + count].
+struct OctreeNode {
+    static constexpr std::uint32_t kInner = 0xFFFFFFFFu;
+    std::uint32_t first = 0;
+    std::uint32_t count = 0;
+
+    bool is_leaf() const { return count != kInner; }
+};
+static_assert(sizeof(OctreeNode) == 8, "octree nodes are two 32-bit words");
+
+struct Octree {
+    Box3f cube;                        ///< the root's box, a cube
+    std::vector<OctreeNode> nodes;     ///< nodes[0] is the root; empty if there is nothing to trace
+    std::vector<std::uint32_t> refs;   ///< primitive numbers, ascending within each leaf
+    float margin = 0;                  ///< boxes were widened by this for placement
+    int depth = 0;                     ///< deepest leaf
+
+    bool empty() const { return nodes.empty(); }
+    std::size_t bytes() const { return nodes.size() * sizeof(OctreeNode) + refs.size() * sizeof(std::uint32_t); }
+};
+
+}  // namespace raypack

@@ -1,0 +1,206 @@
+#include "accel/octree/octree_accel.h"
+
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+#include <cmath>
+#include <vector>
+
+#include "accel/octree/octree_build.h"
+#include "accel/octree/octree_packet.h"
+#include "accel/octree/revelles.h"
+
+namespace raypack {
+
+OctreeAccel::OctreeAccel(const Scene& scene, const AccelConfig& config, const OctreeConfig& octree_config)
+    : scene_(&scene), kernels_(config.kernels) {
+    const auto start = std::chrono::steady_clock::now();
+    const std::size_t n = scene.primitive_count();
+    std::vector<Box3f> boxes(n);
+    tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) { boxes[i] = primitive_bounds(scene, std::uint32_t(i)); });
+    const PrimitiveBoxOverlap exact{&scene};
+    tree_ = build_octree(boxes, octree_config.exact_overlap ? &exact : nullptr, octree_config);
+    const auto stop = std::chrono::steady_clock::now();
+    std::size_t leaves = 0;
+    for (const OctreeNode& node : tree_.nodes) {
+        leaves += node.is_leaf();
+        empty_leaves_ += node.is_leaf() && node.count == 0;
+    }
+    stats_.name = "octree";
+    stats_.builder = "adaptive";
+    stats_.build_ms = std::chrono::duration<double, std::milli>(stop - start).count();
+    stats_.nodes = tree_.nodes.size();
+    stats_.leaves = leaves;
+    stats_.bytes = tree_.bytes();
+    stats_.depth = tree_.depth;
+}
+
+double OctreeAccel::references_per_primitive() const {
+    const std::size_t n = scene_->primitive_count();
+    return n ? double(tree_.refs.size()) / double(n) : 0.0;
+}
+
+namespace {
+
+/// One inner node of the walk: its slab parameters and the next child to
+/// visit (mirrored numbering; 8 = done). The explicit stack holds these for
+/// the ancestors of the current node, in place of the paper's recursion.
+struct Frame {
+    float t0[3], tm[3], t1[3];
+    std::uint32_t children;
+    int child;
+};
+
+}  // namespace
+
+// Closest hit or any hit. Nodes are visited front to back along the ray, so a
+// hit at or before the current node's exit ends the walk: every later node
+// starts at or after that exit. Hits the kernels report are genuine hits in
+// [tnear, tfar] even when they lie beyond the current leaf, and shrink tfar.
+template <bool AnyHit, bool Counting>
+bool OctreeAccel::trace(Rayf& ray, Hitf& hit, OctreeRayCounters* counters) const {
+    if constexpr (Counting) ++counters->rays;
+    if (tree_.empty()) return false;
+    const Vec3f rdir = reciprocal(ray.dir);
+    const Box3f& cube = tree_.cube;
+    unsigned a = 0;
+    Frame f;
+    for (int k = 0; k < 3; ++k) {
+        // Computed as the robust slab test computes its distances.
+        const float lo = (cube.lo[k] - ray.org[k]) * rdir[k], hi = (cube.hi[k] - ray.org[k]) * rdir[k];
+        const bool mirrored = std::signbit(ray.dir[k]);
+        a |= mirrored ? 4u >> k : 0u;
+        f.t0[k] = mirrored ? hi : lo;
+        f.t1[k] = mirrored ? lo : hi;
+        f.tm[k] = 0.5f * (f.t0[k] + f.t1[k]);
+    }
+    const float enter = std::max({f.t0[0], f.t0[1], f.t0[2]}), exit = std::min({f.t1[0], f.t1[1], f.t1[2]});
+    if (!(std::max(enter, ray.tnear) <= std::min(exit, ray.tfar))) return false;
+
+    const PrimitiveIntersector<float> isect{scene_, kernels_};
+    const OctreeNode* nodes = tree_.nodes.data();
+    const std::uint32_t* refs = tree_.refs.data();
+    bool found = false;
+    // The primitives of a leaf; true if the walk may stop (any hit found).
+    auto test_leaf = [&](const OctreeNode& leaf) {
+        if constexpr (Counting) ++counters->leaves_visited;
+        for (std::uint32_t k = leaf.first; k < leaf.first + leaf.count; ++k) {
+            if constexpr (Counting) ++counters->prim_tests;
+            if (isect.intersect(refs[k], ray, hit)) {
+                found = true;
+                if constexpr (AnyHit) return true;
+            }
+        }
+        return false;
+    };
+    if constexpr (Counting) ++counters->nodes_visited;
+    if (nodes[0].is_leaf()) {
+        test_leaf(nodes[0]);
+        return found;
+    }
+    f.children = nodes[0].first;
+    f.child = revelles::first_node(f.tm[0], f.tm[1], f.tm[2], std::max(enter, ray.tnear));
+    Frame stack[kOctreeMaxDepth];
+    int sp = 0;
+    for (;;) {
+        if (f.child >= 8) {
+            if (sp == 0) break;
+            f = stack[--sp];
+            continue;
+        }
+        const int c = f.child;
+        float c0[3], c1[3];
+        for (int k = 0; k < 3; ++k) {
+            const bool upper = c & (4 >> k);
+            c0[k] = upper ? f.tm[k] : f.t0[k];
+            c1[k] = upper ? f.t1[k] : f.tm[k];
+        }
+        f.child = revelles::new_node(c, c1[0], c1[1], c1[2]);
+        const OctreeNode node = nodes[f.children + (unsigned(c) ^ a)];
+        if constexpr (Counting) ++counters->nodes_visited;
+        if (node.count == 0) continue;  // an empty leaf
+        const float child_exit = std::min({c1[0], c1[1], c1[2]});
+        if (child_exit < ray.tnear) continue;  // behind the ray's start (rounding only: first_node skips these)
+        const float child_enter = std::max({c0[0], c0[1], c0[2]});
+        if (child_enter > ray.tfar) break;  // front to back: every later node starts later
+        if (node.is_leaf()) {
+            if (test_leaf(node)) return true;
+            if (found && ray.tfar <= child_exit) break;
+            continue;
+        }
+        stack[sp++] = f;
+        for (int k = 0; k < 3; ++k) {
+            f.t0[k] = c0[k];
+            f.t1[k] = c1[k];
+            f.tm[k] = 0.5f * (c0[k] + c1[k]);
+        }
+        f.children = node.first;
+        f.child = revelles::first_node(f.tm[0], f.tm[1], f.tm[2], std::max(child_enter, ray.tnear));
+    }
+    return found;
+}
+
+void OctreeAccel::intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const {
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        Rayf ray = rays[i];
+        Hitf hit;
+        trace<false, false>(ray, hit, nullptr);
+        hits[i] = hit;
+    }
+}
+
+void OctreeAccel::occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const {
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        Rayf ray = rays[i];
+        Hitf hit;
+        occluded[i] = trace<true, false>(ray, hit, nullptr) ? 1 : 0;
+    }
+}
+
+Hitf OctreeAccel::intersect_counting(const Rayf& ray_in, OctreeRayCounters& counters) const {
+    Rayf ray = ray_in;
+    Hitf hit;
+    trace<false, true>(ray, hit, &counters);
+    return hit;
+}
+
+bool OctreeAccel::occluded_counting(const Rayf& ray_in, OctreeRayCounters& counters) const {
+    Rayf ray = ray_in;
+    Hitf hit;
+    return trace<true, true>(ray, hit, &counters);
+}
+
+bool OctreeAccel::supports_packet(int width) const {
+    return width == 1 || (width == 4 && kWidthCompiled<4>) || (width == 8 && kWidthCompiled<8>) ||
+           (width == 16 && kWidthCompiled<16>);
+}
+
+template <bool AnyHit>
+void OctreeAccel::trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
+    switch (width) {
+#if defined(__SSE4_2__)
+        case 4: return octree_trace_packets<4, AnyHit>(tree_, *scene_, kernels_, rays, hits);
+#endif
+#if defined(__AVX2__)
+        case 8: return octree_trace_packets<8, AnyHit>(tree_, *scene_, kernels_, rays, hits);
+#endif
+#if defined(__AVX512BW__)
+        case 16: return octree_trace_packets<16, AnyHit>(tree_, *scene_, kernels_, rays, hits);
+#endif
+        default: throw std::invalid_argument("octree: packet width " + std::to_string(width) + " is not compiled in");
+    }
+}
+
+void OctreeAccel::intersect_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
+    if (width == 1) return intersect(rays, hits);
+    trace_packets<false>(width, rays, hits);
+}
+
+void OctreeAccel::occluded_packets(int width, std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const {
+    if (width == 1) return this->occluded(rays, occluded);
+    std::vector<Hitf> hits(rays.size());
+    trace_packets<true>(width, rays, hits);
+    for (std::size_t i = 0; i < rays.size(); ++i) occluded[i] = hits[i].found() ? 1 : 0;
+}
+
+}  // namespace raypack

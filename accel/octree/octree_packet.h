@@ -1,0 +1,23 @@
+#pragma once
+// Packet traversal of the octree: the lanes of a packet whose directions lie
+// in one octant walk the tree together in one shared front-to-back order,
+// each inner node's children tested with the parametric intervals of
+// Revelles et al. (lane-wise), leaves tested for the lanes that reach them.
+#include <cstdint>
+#include <span>
+
+#include "accel/octree/octree.h"
+#include "accel/primitive_intersector.h"
+#include "kernels/ray.h"
+#include "scene/scene.h"
+
+namespace raypack {
+
+/// Closest hits (AnyHit = false) or occlusion (AnyHit = true, hits[i].prim
+/// = 0 where occluded) of `rays` in packets of K. Defined for the K that are
+/// compiled in (see kWidthCompiled).
+template <int K, bool AnyHit>
+void octree_trace_packets(const Octree& tree, const Scene& scene, KernelChoice kernels, std::span<const Rayf> rays,
+                          std::span<Hitf> hits);
+
+}  // namespace raypack

@@ -1,0 +1,751 @@
+// The octree (accel/octree/) against the brute-force oracle. It runs the very
+// same primitive kernels as the oracle, so it must agree exactly: the same
+// hit or miss on every ray, bit-identical t for the same primitive, another
+// primitive only at a shared edge or vertex (t within 1e-5), the same
+// occlusion answers; and its packets of every width must give what its
+// single rays give. Adversarial rays are built from the octree's own planes:
+// along the cube's midplanes at several depths, through node corners, from
+// inside leaves and on node boundaries, axis-parallel with +-0 components.
+#include <gtest/gtest.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <functional>
+#include <iomanip>
+#include <limits>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "accel/accel.h"
+#include "accel/brute/brute_force.h"
+#include "accel/grid/triangle_box_overlap.h"
+#include "accel/octree/octree_accel.h"
+#include "accel/octree/octree_build.h"
+#include "accel/octree/revelles.h"
+#include "render/camera_rays.h"
+#include "scene/load.h"
+
+namespace raypack::octree_test {
+namespace {
+
+// ---- Tracing and comparing --------------------------------------------------------
+
+std::string describe(const Rayf& r) {
+    std::ostringstream os;
+    os << std::hexfloat << "org (" << r.org.x << ", " << r.org.y << ", " << r.org.z << ") dir (" << r.dir.x << ", "
+       << r.dir.y << ", " << r.dir.z << ") tnear " << r.tnear << " tfar " << r.tfar << std::defaultfloat << " ["
+       << r.org.x << ", " << r.org.y << ", " << r.org.z << " / " << r.dir.x << ", " << r.dir.y << ", " << r.dir.z
+       << "]";
+    return os.str();
+}
+
+std::string describe(const Hitf& h) {
+    if (!h.found()) return "miss";
+    std::ostringstream os;
+    os << "prim " << h.prim << " t " << std::setprecision(9) << h.t;
+    return os.str();
+}
+
+/// Both cores; packets of `width` (1 = single rays), in chunks that are
+/// multiples of 16 so that packets are the same whatever the schedule.
+std::vector<Hitf> trace(const Accel& accel, const std::vector<Rayf>& rays, int width = 1) {
+    std::vector<Hitf> hits(rays.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, (rays.size() + 63) / 64), [&](const auto& r) {
+        const std::size_t first = r.begin() * 64, last = std::min(rays.size(), r.end() * 64);
+        const auto in = std::span<const Rayf>(rays).subspan(first, last - first);
+        const auto out = std::span<Hitf>(hits).subspan(first, last - first);
+        if (width == 1) accel.intersect(in, out);
+        else accel.intersect_packets(width, in, out);
+    });
+    return hits;
+}
+
+std::vector<std::uint8_t> trace_occluded(const Accel& accel, const std::vector<Rayf>& rays, int width = 1) {
+    std::vector<std::uint8_t> occ(rays.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, (rays.size() + 63) / 64), [&](const auto& r) {
+        const std::size_t first = r.begin() * 64, last = std::min(rays.size(), r.end() * 64);
+        const auto in = std::span<const Rayf>(rays).subspan(first, last - first);
+        const auto out = std::span<std::uint8_t>(occ).subspan(first, last - first);
+        if (width == 1) accel.occluded(in, out);
+        else accel.occluded_packets(width, in, out);
+    });
+    return occ;
+}
+
+std::string hit_mismatches(const std::vector<Rayf>& rays, const std::vector<Hitf>& want, const std::vector<Hitf>& got,
+                           std::size_t& count, const char* want_name, const char* got_name) {
+    std::string first;
+    count = 0;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        bool ok = want[i].found() == got[i].found();
+        if (ok && want[i].found()) {
+            ok = want[i].prim == got[i].prim
+                     ? want[i].t == got[i].t
+                     : std::fabs(want[i].t - got[i].t) <= 1e-5f * std::max(std::fabs(want[i].t), std::fabs(got[i].t));
+        }
+        if (ok) continue;
+        if (++count <= 5)
+            first += "\n  ray " + std::to_string(i) + ": " + describe(rays[i]) + "\n    " + want_name + " " +
+                     describe(want[i]) + ", " + got_name + " " + describe(got[i]);
+    }
+    return first;
+}
+
+std::string occlusion_mismatches(const std::vector<Rayf>& rays, const std::vector<std::uint8_t>& want,
+                                 const std::vector<std::uint8_t>& got, std::size_t& count) {
+    std::string first;
+    count = 0;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        if (want[i] == got[i]) continue;
+        if (++count <= 5)
+            first += "\n  ray " + std::to_string(i) + ": " + describe(rays[i]) + "\n    want " +
+                     (want[i] ? "occluded" : "clear") + ", got " + (got[i] ? "occluded" : "clear");
+    }
+    return first;
+}
+
+std::vector<int> packet_widths() {
+    std::vector<int> w;
+    if constexpr (kWidthCompiled<4>) w.push_back(4);
+    if constexpr (kWidthCompiled<8>) w.push_back(8);
+    if constexpr (kWidthCompiled<16>) w.push_back(16);
+    return w;
+}
+
+/// Closest hit and occlusion of every ray against brute force, single rays
+/// and packets of every width.
+void expect_agreement(const Scene& scene, const Accel& octree, const std::vector<Rayf>& rays, const std::string& what) {
+    const BruteForce brute(scene, KernelChoice{});
+    const std::vector<Hitf> truth = trace(brute, rays);
+    std::vector<std::uint8_t> occluded(rays.size());
+    for (std::size_t i = 0; i < rays.size(); ++i) occluded[i] = truth[i].found() ? 1 : 0;
+    const std::vector<Hitf> single = trace(octree, rays);
+    std::size_t n = 0;
+    std::string s = hit_mismatches(rays, truth, single, n, "brute", "octree");
+    EXPECT_EQ(n, 0u) << what << ": " << n << " of " << rays.size() << " closest hits differ" << s;
+    s = occlusion_mismatches(rays, occluded, trace_occluded(octree, rays), n);
+    EXPECT_EQ(n, 0u) << what << ": " << n << " of " << rays.size() << " occlusion answers differ" << s;
+    for (int w : packet_widths()) {
+        s = hit_mismatches(rays, single, trace(octree, rays, w), n, "single", "packet");
+        EXPECT_EQ(n, 0u) << what << " K=" << w << ": " << n << " of " << rays.size() << " packet hits differ" << s;
+        s = occlusion_mismatches(rays, occluded, trace_occluded(octree, rays, w), n);
+        EXPECT_EQ(n, 0u) << what << " K=" << w << ": " << n << " of " << rays.size() << " packet occlusions differ"
+                         << s;
+    }
+}
+
+// ---- Ray sets -----------------------------------------------------------------------
+
+std::vector<Rayf> camera_rays(const Scene& scene, int size) {
+    const CameraFrame f = make_camera_frame(scene.camera, size, size);
+    std::vector<Rayf> rays;
+    // 4x4 tiles, so that packets of 16 are square.
+    for (int ty = 0; ty < size; ty += 4)
+        for (int tx = 0; tx < size; tx += 4)
+            for (int y = ty; y < std::min(size, ty + 4); ++y)
+                for (int x = tx; x < std::min(size, tx + 4); ++x)
+                    rays.push_back(camera_ray(f, float(x) + 0.5f, float(y) + 0.5f));
+    return rays;
+}
+
+Vec3f random_direction(std::mt19937& rng) {
+    std::normal_distribution<float> n;
+    for (;;) {
+        const Vec3f d{n(rng), n(rng), n(rng)};
+        if (dot(d, d) > 1e-6f) return normalize(d);
+    }
+}
+
+Vec3f random_point(std::mt19937& rng, const Box3f& box) {
+    std::uniform_real_distribution<float> u(0, 1);
+    const Vec3f e = box.extent();
+    return {box.lo.x + u(rng) * e.x, box.lo.y + u(rng) * e.y, box.lo.z + u(rng) * e.z};
+}
+
+float signed_zero(std::mt19937& rng) { return rng() % 2 ? 0.0f : -0.0f; }
+
+Box3f grown(Box3f b, float f) {
+    const Vec3f e = b.extent() * f;
+    b.lo -= e;
+    b.hi += e;
+    return b;
+}
+
+std::vector<Rayf> random_rays(const Scene& scene, std::mt19937& rng, int n) {
+    const Box3f box = scene_bounds(scene);
+    const float diag = length(box.extent());
+    std::uniform_real_distribution<float> u(0, 1);
+    std::vector<Rayf> rays(n);
+    for (int i = 0; i < n; ++i) {
+        rays[i].org = random_point(rng, grown(box, 0.2f));
+        rays[i].dir = random_direction(rng);
+        if (i % 2) rays[i].tfar = u(rng) * diag;
+    }
+    return rays;
+}
+
+/// Rays that make an octree traversal stumble, from the tree's own planes:
+/// the cube's midplanes at depths 1 to 6 (node faces at those depths).
+std::vector<Rayf> octree_adversarial_rays(const Octree& tree, const Scene& scene, std::mt19937& rng) {
+    std::vector<Rayf> rays;
+    const Box3f box = tree.cube;
+    const float side = box.hi.x - box.lo.x;
+    const float diag = length(box.extent());
+    std::uniform_real_distribution<float> u(0, 1);
+    // A node plane at a random depth 1..6: lo + side * k / 2^d, as the traversal sees it.
+    auto plane = [&](int axis) {
+        const int d = 1 + int(rng() % 6);
+        const int k = int(rng() % ((1u << d) + 1));
+        return box.lo[axis] + (box.hi[axis] - box.lo[axis]) * (float(k) / float(1 << d));
+    };
+    auto corner = [&] { return Vec3f{plane(0), plane(1), plane(2)}; };
+    auto axis_dir = [&](int axis, float sign) {
+        Vec3f d{signed_zero(rng), signed_zero(rng), signed_zero(rng)};
+        d[axis] = sign;
+        return d;
+    };
+    // 1. Along node edges: the two other coordinates on node planes, axis-parallel, from outside.
+    for (int i = 0; i < 600; ++i) {
+        const int a = i % 3;
+        const float sign = (i / 3) % 2 ? 1.0f : -1.0f;
+        Rayf r;
+        r.org = corner();
+        r.org[a] = sign > 0 ? box.lo[a] - 0.1f * diag : box.hi[a] + 0.1f * diag;
+        r.dir = axis_dir(a, sign);
+        rays.push_back(r);
+    }
+    // 2. Inside a node plane (that direction component +-0), from inside the cube.
+    for (int i = 0; i < 600; ++i) {
+        const int a = i % 3;
+        Rayf r;
+        r.org = random_point(rng, box);
+        r.org[a] = plane(a);
+        r.dir = random_direction(rng);
+        r.dir[a] = signed_zero(rng);
+        rays.push_back(r);
+    }
+    // 3. Axis-parallel from random origins in and around the cube; half with a finite tfar.
+    for (int i = 0; i < 600; ++i) {
+        Rayf r;
+        r.org = random_point(rng, grown(box, 0.1f));
+        r.dir = axis_dir(i % 3, (i / 3) % 2 ? 1.0f : -1.0f);
+        if (i % 2) r.tfar = u(rng) * diag;
+        rays.push_back(r);
+    }
+    // 4. Starting inside the octree (in leaves), some from tnear > 0.
+    for (int i = 0; i < 600; ++i) {
+        Rayf r;
+        r.org = random_point(rng, box);
+        r.dir = random_direction(rng);
+        if (i % 2) r.tnear = u(rng) * 0.5f * diag;
+        if (i % 3 == 0) r.tfar = r.tnear + u(rng) * 0.5f * diag;
+        rays.push_back(r);
+    }
+    // 5. Starting exactly on node boundaries (faces, edges, corners).
+    for (int i = 0; i < 600; ++i) {
+        Rayf r;
+        r.org = random_point(rng, box);
+        for (int a = 0; a < 3; ++a)
+            if (a == i % 3 || rng() % 3 == 0) r.org[a] = plane(a);
+        r.dir = random_direction(rng);
+        rays.push_back(r);
+    }
+    // 6. Through node corners, and from node corners.
+    for (int i = 0; i < 900; ++i) {
+        Rayf r;
+        const Vec3f c = corner();
+        if (i % 3 == 0) {
+            r.org = c;
+            r.dir = random_direction(rng);
+        } else {
+            r.org = random_point(rng, grown(box, 0.5f));
+            r.dir = c - r.org;
+            if (!(dot(r.dir, r.dir) > 0)) r.dir = {1, 1, 1};
+        }
+        rays.push_back(r);
+    }
+    // 7. Along node diagonals: ties between all three axes at every midplane.
+    for (int i = 0; i < 300; ++i) {
+        Rayf r;
+        const float s = side / float(1 << (1 + rng() % 5));
+        Vec3f d{s, s, s};
+        for (int a = 0; a < 3; ++a)
+            if (rng() % 2) d[a] = -d[a];
+        r.org = corner() - d * float(1 + rng() % 4);
+        r.dir = d;
+        rays.push_back(r);
+    }
+    // 8. From far away (10 cube diagonals), aimed into the cube.
+    for (int i = 0; i < 300; ++i) {
+        Rayf r;
+        const Vec3f target = random_point(rng, box);
+        r.org = target - random_direction(rng) * (10.0f * diag);
+        r.dir = target - r.org;
+        rays.push_back(r);
+    }
+    // 9. Aimed at triangle vertices and sphere poles.
+    const auto nprims = std::uint32_t(scene.primitive_count());
+    for (int i = 0; i < 300 && nprims; ++i) {
+        const PrimRef ref = scene.prims[rng() % nprims];
+        Vec3f target;
+        if (ref.kind == PrimKind::Triangle) {
+            target = scene.triangles.p0[ref.index];
+        } else if (ref.kind == PrimKind::Sphere) {
+            target = scene.spheres.center[ref.index];
+            target[int(rng() % 3)] += scene.spheres.radius[ref.index];
+        } else {
+            target = scene.cones.apex[ref.index];
+        }
+        Rayf r;
+        r.org = random_point(rng, grown(box, 0.2f));
+        r.dir = target - r.org;
+        if (!(dot(r.dir, r.dir) > 0)) r.dir = {0, 0, 1};
+        rays.push_back(r);
+    }
+    return rays;
+}
+
+std::vector<Rayf> shadow_rays(const Scene& scene, const std::vector<Rayf>& rays, const std::vector<Hitf>& hits) {
+    std::vector<Rayf> out;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        if (!hits[i].found()) continue;
+        const Vec3f p = rays[i].org + rays[i].dir * hits[i].t;
+        for (const PointLight& light : scene.lights) {
+            Rayf s;
+            s.org = p;
+            s.dir = light.position - p;
+            s.tnear = 1e-4f;
+            s.tfar = 1.0f - 1e-4f;
+            out.push_back(s);
+        }
+    }
+    return out;
+}
+
+std::unique_ptr<OctreeAccel> make_octree(const Scene& scene, const OctreeConfig& oc = {}) {
+    return std::make_unique<OctreeAccel>(scene, AccelConfig{}, oc);
+}
+
+/// Structural invariants: leaves obey leaf_size unless at max depth or
+/// unsplittable, references ascend within leaves and are in range, and the
+/// statistics count what is there.
+void expect_well_formed(const OctreeAccel& accel, const Scene& scene, const OctreeConfig& oc) {
+    const Octree& t = accel.octree();
+    if (t.empty()) return;
+    const Vec3f e = t.cube.extent();
+    EXPECT_EQ(e.x, e.y);
+    EXPECT_EQ(e.y, e.z);
+    std::size_t leaves = 0, empty = 0, refs = 0;
+    int depth = 0;
+    // Depth of each node by a walk from the root.
+    std::vector<std::pair<std::uint32_t, int>> todo = {{0, 0}};
+    std::vector<bool> seen(t.nodes.size(), false);
+    while (!todo.empty()) {
+        const auto [i, d] = todo.back();
+        todo.pop_back();
+        ASSERT_LT(i, t.nodes.size());
+        ASSERT_FALSE(seen[i]);
+        seen[i] = true;
+        const OctreeNode& node = t.nodes[i];
+        if (node.is_leaf()) {
+            ++leaves;
+            empty += node.count == 0;
+            refs += node.count;
+            depth = std::max(depth, d);
+            EXPECT_LE(d, oc.max_depth);
+            ASSERT_LE(std::size_t(node.first) + node.count, t.refs.size());
+            for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
+                EXPECT_LT(t.refs[k], scene.primitive_count());
+                if (k > node.first) {
+                    EXPECT_LT(t.refs[k - 1], t.refs[k]);
+                }
+            }
+        } else {
+            EXPECT_LT(d, oc.max_depth);
+            for (std::uint32_t c = 0; c < 8; ++c) todo.push_back({node.first + c, d + 1});
+        }
+    }
+    EXPECT_EQ(std::count(seen.begin(), seen.end(), false), 0);
+    EXPECT_EQ(refs, t.refs.size());
+    const AccelStats& s = accel.stats();
+    EXPECT_EQ(s.name, "octree");
+    EXPECT_EQ(s.builder, "adaptive");
+    EXPECT_EQ(s.nodes, t.nodes.size());
+    EXPECT_EQ(s.leaves, leaves);
+    EXPECT_EQ(s.depth, depth);
+    EXPECT_EQ(accel.empty_leaves(), empty);
+    EXPECT_EQ(s.bytes, t.nodes.size() * 8 + t.refs.size() * 4);
+    EXPECT_GE(s.build_ms, 0.0);
+    if (scene.primitive_count()) {
+        EXPECT_GE(accel.references_per_primitive(), 1.0);
+    }
+}
+
+// ---- Every shared scene -------------------------------------------------------------
+
+std::vector<std::string> scene_files() {
+    std::vector<std::string> files;
+    for (const auto& e : std::filesystem::directory_iterator(std::string(RAYPACK_SOURCE_DIR) + "/scenes"))
+        if (e.path().extension() == ".nff") files.push_back(e.path().filename().string());
+    std::sort(files.begin(), files.end());
+    files.push_back("bunny.obj");
+    return files;
+}
+
+// One fixture for the whole suite, so that every test is called Octree.*.
+class Octree : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(Octree, MatchesBruteForce) {
+    const Scene scene = load_scene(std::string(RAYPACK_SOURCE_DIR) + "/scenes/" + GetParam());
+    AccelConfig config;
+    config.kind = "octree";
+    const std::unique_ptr<Accel> accel = build_accel(scene, config);
+    const auto& octree = dynamic_cast<const OctreeAccel&>(*accel);
+    std::mt19937 rng(20240605);
+    const BruteForce brute(scene, KernelChoice{});
+
+    const std::vector<Rayf> camera = camera_rays(scene, 64);
+    expect_agreement(scene, octree, camera, GetParam() + " camera");
+    expect_agreement(scene, octree, random_rays(scene, rng, 2000), GetParam() + " random");
+    expect_agreement(scene, octree, octree_adversarial_rays(octree.octree(), scene, rng), GetParam() + " adversarial");
+    const std::vector<Rayf> shadows = shadow_rays(scene, camera, trace(brute, camera));
+    const std::vector<std::uint8_t> want = trace_occluded(brute, shadows);
+    std::size_t n = 0;
+    std::string occ = occlusion_mismatches(shadows, want, trace_occluded(octree, shadows), n);
+    EXPECT_EQ(n, 0u) << GetParam() << " shadow: " << n << " of " << shadows.size() << " occlusion answers differ" << occ;
+    for (int w : packet_widths()) {
+        occ = occlusion_mismatches(shadows, want, trace_occluded(octree, shadows, w), n);
+        EXPECT_EQ(n, 0u) << GetParam() << " shadow K=" << w << ": " << n << " occlusion answers differ" << occ;
+    }
+    expect_well_formed(octree, scene, OctreeConfig{});
+    RecordProperty("nodes", std::to_string(octree.stats().nodes));
+    RecordProperty("refs_per_prim", std::to_string(octree.references_per_primitive()));
+}
+
+std::string param_name(const ::testing::TestParamInfo<std::string>& info) {
+    std::string s = info.param;
+    std::replace(s.begin(), s.end(), '.', '_');
+    return s;
+}
+
+INSTANTIATE_TEST_SUITE_P(, Octree, ::testing::ValuesIn(scene_files()), param_name);
+
+// ---- Hand-made scenes -----------------------------------------------------------------
+
+Scene scene_with(const std::function<void(Scene&)>& add) {
+    Scene s;
+    s.materials.push_back({});
+    add(s);
+    s.update_features();
+    return s;
+}
+
+TEST_F(Octree, RegisteredAsAnAccelKind) {
+    const auto kinds = accel_kinds();
+    EXPECT_NE(std::find_if(kinds.begin(), kinds.end(), [](const char* k) { return std::string(k) == "octree"; }),
+              kinds.end());
+    EXPECT_NE(accel_kinds_list().find("octree"), std::string::npos);
+    const Scene scene = scene_with([](Scene& s) { s.add_sphere({0, 0, 0}, 1, 0); });
+    AccelConfig config;
+    config.kind = "octree";
+    const auto accel = build_accel(scene, config);
+    EXPECT_EQ(accel->stats().name, "octree");
+    for (int w : packet_widths()) EXPECT_TRUE(accel->supports_packet(w));
+    EXPECT_TRUE(accel->supports_packet(1));
+    EXPECT_FALSE(accel->supports_packet(3));
+}
+
+TEST_F(Octree, StateTableIsThePapers) {
+    // new_node: from child c, leaving through axis k's plane, moves to c | bit
+    // if that bit was clear, else out of the parent (8).
+    for (int c = 0; c < 8; ++c) {
+        for (int k = 0; k < 3; ++k) {
+            const int bit = 4 >> k;
+            EXPECT_EQ(revelles::kNext[c][k], (c & bit) ? 8 : (c | bit)) << c << " " << k;
+        }
+    }
+    EXPECT_EQ(revelles::new_node(0, 1, 2, 3), 4);
+    EXPECT_EQ(revelles::new_node(0, 2, 1, 3), 2);
+    EXPECT_EQ(revelles::new_node(0, 3, 2, 1), 1);
+    EXPECT_EQ(revelles::new_node(3, 1, 2, 3), 7);
+    EXPECT_EQ(revelles::first_node(1, 1, 1, 0), 0);
+    EXPECT_EQ(revelles::first_node(-1, 1, -1, 0), 5);
+}
+
+TEST_F(Octree, OnePrimitiveOfEachKind) {
+    const std::vector<Scene> scenes = {
+        scene_with([](Scene& s) { s.add_sphere({1, 2, 3}, 0.5f, 0); }),
+        scene_with([](Scene& s) { s.add_triangle({0, 0, 0}, {1, 0, 0}, {0, 1, 1}, 0); }),
+        scene_with([](Scene& s) { s.add_cone({0, 0, 0}, 0.5f, {0, 0, 2}, 0.1f, 0); }),
+    };
+    std::mt19937 rng(7);
+    for (const Scene& scene : scenes) {
+        const auto octree = make_octree(scene);
+        EXPECT_EQ(octree->stats().nodes, 1u);
+        std::vector<Rayf> rays = random_rays(scene, rng, 500);
+        const std::vector<Rayf> adv = octree_adversarial_rays(octree->octree(), scene, rng);
+        rays.insert(rays.end(), adv.begin(), adv.end());
+        expect_agreement(scene, *octree, rays, "one " + std::to_string(int(scene.prims[0].kind)));
+    }
+}
+
+TEST_F(Octree, EmptySceneMissesEverything) {
+    const Scene scene;
+    const auto octree = make_octree(scene);
+    Rayf r;
+    r.dir = {1, 1, 1};
+    EXPECT_FALSE(octree->intersect1(r).found());
+    EXPECT_FALSE(octree->occluded1(r));
+    EXPECT_EQ(octree->stats().nodes, 0u);
+    std::vector<Rayf> rays(20, r);
+    for (int w : packet_widths()) {
+        for (const Hitf& h : trace(*octree, rays, w)) EXPECT_FALSE(h.found());
+        for (std::uint8_t o : trace_occluded(*octree, rays, w)) EXPECT_EQ(o, 0);
+    }
+}
+
+/// A triangulated square of n x n quads in the plane `axis` = 0.5, plus
+/// random triangles in the same plane.
+Scene flat_scene(int axis, int n, std::mt19937& rng) {
+    return scene_with([&](Scene& s) {
+        auto point = [&](float u, float v) {
+            Vec3f p;
+            p[axis] = 0.5f;
+            p[(axis + 1) % 3] = u;
+            p[(axis + 2) % 3] = v;
+            return p;
+        };
+        const float h = 1.0f / float(n);
+        for (int i = 0; i < n; ++i) {
+            for (int j = 0; j < n; ++j) {
+                const float u = float(i) * h, v = float(j) * h;
+                s.add_triangle(point(u, v), point(u + h, v), point(u + h, v + h), 0);
+                s.add_triangle(point(u, v), point(u + h, v + h), point(u, v + h), 0);
+            }
+        }
+        std::uniform_real_distribution<float> u(0, 1);
+        for (int i = 0; i < 100; ++i) s.add_triangle(point(u(rng), u(rng)), point(u(rng), u(rng)), point(u(rng), u(rng)), 0);
+    });
+}
+
+TEST_F(Octree, FlatScenes) {
+    std::mt19937 rng(11);
+    for (int axis = 0; axis < 3; ++axis) {
+        SCOPED_TRACE(axis);
+        const Scene scene = flat_scene(axis, 24, rng);
+        const auto octree = make_octree(scene);
+        expect_well_formed(*octree, scene, OctreeConfig{});
+        // The plane lies in the cube's midplane along `axis`: it is split
+        // anyway, and both halves hold the whole plane only where it matters.
+        EXPECT_GT(octree->stats().depth, 2);
+        std::vector<Rayf> rays = random_rays(scene, rng, 1000);
+        const std::vector<Rayf> adv = octree_adversarial_rays(octree->octree(), scene, rng);
+        rays.insert(rays.end(), adv.begin(), adv.end());
+        std::uniform_real_distribution<float> u(0, 1);
+        for (int i = 0; i < 1000; ++i) {
+            Rayf r;
+            r.org[axis] = 0.5f;
+            r.org[(axis + 1) % 3] = u(rng) * 1.4f - 0.2f;
+            r.org[(axis + 2) % 3] = u(rng) * 1.4f - 0.2f;
+            r.dir = random_direction(rng);
+            if (i % 2) {
+                r.dir[axis] = signed_zero(rng);  // in the plane
+            } else {
+                r.org -= r.dir * (0.5f + u(rng));  // across the plane, starting off it
+            }
+            rays.push_back(r);
+        }
+        expect_agreement(scene, *octree, rays, "flat " + std::to_string(axis));
+    }
+}
+
+TEST_F(Octree, PrimitivesSpanningManyNodes) {
+    std::mt19937 rng(13);
+    std::uniform_real_distribution<float> u(0, 1);
+    const Scene scene = scene_with([&](Scene& s) {
+        for (int i = 0; i < 2000; ++i) {
+            const Vec3f p{u(rng) * 10, u(rng) * 10, u(rng) * 10};
+            s.add_triangle(p, p + Vec3f{0.2f, 0, 0}, p + Vec3f{0, 0.2f, 0.1f}, 0);
+        }
+        // Huge triangles across the whole box, a big sphere and a long thin cone.
+        s.add_triangle({-1, -1, 5}, {11, -1, 5.5f}, {5, 11, 4}, 0);
+        s.add_triangle({0, 0, 0}, {10, 10, 10}, {10, 0, 10}, 0);
+        s.add_sphere({5, 5, 5}, 3, 0);
+        s.add_cone({0, 10, 0}, 0.3f, {10, 0, 10}, 0.3f, 0);
+    });
+    const auto octree = make_octree(scene);
+    expect_well_formed(*octree, scene, OctreeConfig{});
+    std::vector<std::size_t> leaves_of(scene.primitive_count(), 0);
+    for (std::uint32_t p : octree->octree().refs) ++leaves_of[p];
+    for (std::uint32_t p = 2000; p < 2004; ++p) EXPECT_GT(leaves_of[p], 20u) << p;
+    std::vector<Rayf> rays = random_rays(scene, rng, 3000);
+    const std::vector<Rayf> adv = octree_adversarial_rays(octree->octree(), scene, rng);
+    rays.insert(rays.end(), adv.begin(), adv.end());
+    expect_agreement(scene, *octree, rays, "spanning");
+}
+
+TEST_F(Octree, UnsplittableNodesStayLeaves) {
+    // 40 triangles meeting at the centre of the cube (the scene is point
+    // symmetric): every octant touches the centre, so gets all of them.
+    const Scene scene = scene_with([](Scene& s) {
+        for (int i = 0; i < 20; ++i) {
+            const float a = float(i) * 0.314f, b = a + 0.1f;
+            const Vec3f p{std::cos(a), std::sin(a), 0.3f * float(i % 3) - 0.3f};
+            const Vec3f q{std::cos(b), std::sin(b), 0.5f - 0.05f * float(i % 5)};
+            s.add_triangle({0, 0, 0}, p, q, 0);
+            s.add_triangle({0, 0, 0}, Vec3f{0, 0, 0} - p, Vec3f{0, 0, 0} - q, 0);
+        }
+    });
+    OctreeConfig oc;
+    oc.leaf_size = 2;
+    const auto octree = make_octree(scene, oc);
+    expect_well_formed(*octree, scene, oc);
+    EXPECT_EQ(octree->stats().nodes, 1u);
+    std::mt19937 rng(5);
+    expect_agreement(scene, *octree, random_rays(scene, rng, 1000), "fan");
+}
+
+TEST_F(Octree, ConfigurationsAgree) {
+    // Leaf size, depth and placement change the tree, never the answers.
+    const Scene scene = load_scene(std::string(RAYPACK_SOURCE_DIR) + "/scenes/tetra.nff");
+    std::mt19937 rng(3);
+    const std::vector<Rayf> rays = random_rays(scene, rng, 2000);
+    for (int leaf : {1, 4, 32}) {
+        for (int depth : {0, 3, 16}) {
+            for (bool exact : {true, false}) {
+                OctreeConfig oc;
+                oc.leaf_size = leaf;
+                oc.max_depth = depth;
+                oc.exact_overlap = exact;
+                const auto octree = make_octree(scene, oc);
+                expect_well_formed(*octree, scene, oc);
+                expect_agreement(scene, *octree, rays,
+                                 "leaf " + std::to_string(leaf) + " depth " + std::to_string(depth) +
+                                     (exact ? " exact" : " boxes"));
+            }
+        }
+    }
+}
+
+TEST_F(Octree, BuildIsDeterministic) {
+    const Scene scene = load_scene(std::string(RAYPACK_SOURCE_DIR) + "/scenes/tetra.nff");
+    const auto a = make_octree(scene), b = make_octree(scene);
+    ASSERT_EQ(a->octree().nodes.size(), b->octree().nodes.size());
+    for (std::size_t i = 0; i < a->octree().nodes.size(); ++i) {
+        EXPECT_EQ(a->octree().nodes[i].first, b->octree().nodes[i].first);
+        EXPECT_EQ(a->octree().nodes[i].count, b->octree().nodes[i].count);
+    }
+    EXPECT_EQ(a->octree().refs, b->octree().refs);
+}
+
+TEST_F(Octree, LeavesHoldTheTrianglesThatMeetThem) {
+    // Every triangle meeting a leaf's box (shrunk by a hair) is in that leaf;
+    // every reference meets the leaf's box widened by the margin.
+    const Scene scene = load_scene(std::string(RAYPACK_SOURCE_DIR) + "/scenes/teapot.nff");
+    const auto octree = make_octree(scene);
+    const raypack::Octree& t = octree->octree();
+    ASSERT_TRUE(scene.features.triangles && !scene.features.spheres && !scene.features.cones);
+    auto tri = [&](std::uint32_t p, const Vec3d& lo, const Vec3d& hi) {
+        const std::uint32_t i = scene.prims[p].index;
+        return triangle_box_overlap((lo + hi) * 0.5, (hi - lo) * 0.5, Vec3d(scene.triangles.p0[i]),
+                                    Vec3d(scene.triangles.p1[i]), Vec3d(scene.triangles.p2[i]));
+    };
+    std::size_t checked = 0;
+    std::function<void(std::uint32_t, Vec3d, Vec3d)> visit = [&](std::uint32_t n, Vec3d lo, Vec3d hi) {
+        const OctreeNode& node = t.nodes[n];
+        if (!node.is_leaf()) {
+            const Vec3d mid = (lo + hi) * 0.5;
+            for (int c = 0; c < 8; ++c) {
+                Vec3d clo, chi;
+                for (int a = 0; a < 3; ++a) {
+                    const bool upper = (c >> (2 - a)) & 1;
+                    clo[a] = upper ? mid[a] : lo[a];
+                    chi[a] = upper ? hi[a] : mid[a];
+                }
+                visit(node.first + c, clo, chi);
+            }
+            return;
+        }
+        const auto first = t.refs.begin() + node.first, last = first + node.count;
+        const Vec3d m{t.margin, t.margin, t.margin}, hair = (hi - lo) * 1e-6;
+        if (checked < 4000) {  // the full check on the first leaves
+            for (std::uint32_t p = 0; p < scene.primitive_count(); ++p) {
+                if (tri(p, lo + hair, hi - hair)) {
+                    EXPECT_TRUE(std::binary_search(first, last, p)) << p << " leaf " << n;
+                }
+            }
+        }
+        for (auto it = first; it != last; ++it) EXPECT_TRUE(tri(*it, lo - m, hi + m)) << *it << " leaf " << n;
+        ++checked;
+    };
+    visit(0, Vec3d(t.cube.lo), Vec3d(t.cube.hi));
+    EXPECT_GT(checked, 100u);
+}
+
+TEST_F(Octree, CountingModeAgreesAndCounts) {
+    const Scene scene = load_scene(std::string(RAYPACK_SOURCE_DIR) + "/scenes/teapot.nff");
+    const auto octree = make_octree(scene);
+    const std::vector<Rayf> rays = camera_rays(scene, 32);
+    OctreeRayCounters c;
+    for (const Rayf& r : rays) {
+        const Hitf want = octree->intersect1(r);
+        const Hitf got = octree->intersect_counting(r, c);
+        EXPECT_EQ(want.prim, got.prim);
+        EXPECT_EQ(want.t, got.t);
+        EXPECT_EQ(octree->occluded1(r), octree->occluded_counting(r, c));
+    }
+    EXPECT_EQ(c.rays, 2 * rays.size());
+    EXPECT_GT(c.nodes_visited, c.rays);
+    EXPECT_GT(c.leaves_visited, 0u);
+    EXPECT_GT(c.prim_tests, 0u);
+
+    // Two tiny spheres in opposite corners: a ray along the cube's x axis
+    // through the centre row of depth-1 nodes visits the root and the two
+    // children it crosses (both empty leaves or inner nodes it walks).
+    const Scene corners = scene_with([](Scene& s) {
+        s.add_sphere({0, 0, 0}, 0.01f, 0);
+        s.add_sphere({1, 1, 1}, 0.01f, 0);
+    });
+    OctreeConfig oc;
+    oc.leaf_size = 0;
+    const auto sparse = make_octree(corners, oc);
+    const Box3f cube = sparse->octree().cube;
+    Rayf r;
+    r.org = {cube.lo.x - 1, cube.lo.y + 0.3f * (cube.hi.y - cube.lo.y), cube.lo.z + 0.7f * (cube.hi.z - cube.lo.z)};
+    r.dir = {1, 0, 0};
+    OctreeRayCounters row;
+    EXPECT_FALSE(sparse->intersect_counting(r, row).found());
+    EXPECT_EQ(row.prim_tests, 0u);
+    EXPECT_EQ(row.nodes_visited, 3u);  // root, then children (lower y, upper z): lower x, upper x
+    // A ray that misses the cube visits nothing.
+    r.org = {-1, 5, 5};
+    OctreeRayCounters none;
+    EXPECT_FALSE(sparse->intersect_counting(r, none).found());
+    EXPECT_EQ(none.nodes_visited, 0u);
+    EXPECT_EQ(none.rays, 1u);
+}
+
+TEST_F(Octree, MixedSignPacketsMatchSingleRays) {
+    // Rays in every octant mixed within packets, from one point inside the
+    // scene: every packet splits into several octant groups.
+    const Scene scene = load_scene(std::string(RAYPACK_SOURCE_DIR) + "/scenes/tetra.nff");
+    const auto octree = make_octree(scene);
+    std::mt19937 rng(29);
+    std::vector<Rayf> rays;
+    const Vec3f c = scene_bounds(scene).center();
+    for (int i = 0; i < 4000; ++i) {
+        Rayf r;
+        r.org = c;
+        r.dir = random_direction(rng);
+        if (i % 5 == 0) r.dir[i % 3] = signed_zero(rng);
+        rays.push_back(r);
+    }
+    expect_agreement(scene, *octree, rays, "mixed signs");
+}
+
+}  // namespace
+}  // namespace raypack::octree_test
