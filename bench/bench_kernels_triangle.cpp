@@ -55,9 +55,9 @@ RAYPACK_INLINE mask_of<F> tri_test(const PreparedRay<M, F>& r, const Vec3<F>& p0
 /// registers through the loop.
 template <class F>
 RAYPACK_INLINE void keep(const mask_of<F>& m, const F& t, const F& u, const F& v, F& kt, F& ku, F& kv) {
-    kt = triangle_detail::blend(m, t, kt);
-    ku = triangle_detail::blend(m, u, ku);
-    kv = triangle_detail::blend(m, v, kv);
+    kt = select(m, t, kt);
+    ku = select(m, u, ku);
+    kv = select(m, v, kv);
 }
 
 /// Publishes copies: DoNotOptimize on the running values themselves would

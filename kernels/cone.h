@@ -23,10 +23,10 @@ struct ConeLanes {
 template <class F>
 RAYPACK_INLINE ConeLanes<F> make_cone(const Vec3<F>& base, const F& base_radius, const Vec3<F>& apex,
                                       const F& apex_radius) {
-    const Vec3<F> axis = lanes::sub(apex, base);
+    const Vec3<F> axis = (apex - base);
     ConeLanes<F> c;
     c.base = base;
-    c.h = lanes::sqrt(axis.x * axis.x + axis.y * axis.y + axis.z * axis.z);
+    c.h = vsqrt(axis.x * axis.x + axis.y * axis.y + axis.z * axis.z);
     c.w = {axis.x / c.h, axis.y / c.h, axis.z / c.h};
     c.mid = {(base.x + apex.x) * F(0.5), (base.y + apex.y) * F(0.5), (base.z + apex.z) * F(0.5)};
     c.inv_h = F(1) / c.h;
@@ -44,7 +44,7 @@ RAYPACK_INLINE ConeLanes<F> make_cone(const Vec3<F>& base, const F& base_radius,
 /// generator line crosses the surface once; one along a cylinder's axis
 /// never does.
 template <class F>
-RAYPACK_INLINE lanes::Mask<F> intersect_cone(lanes::Mask<F> valid, const QuadricRay<F>& ray, const ConeLanes<F>& cone,
+RAYPACK_INLINE mask_of<F> intersect_cone(mask_of<F> valid, const QuadricRay<F>& ray, const ConeLanes<F>& cone,
                                              F& t, F& s_frac) {
     const Vec3<F>& org = ray.org;
     const Vec3<F>& dir = ray.dir;
@@ -53,22 +53,22 @@ RAYPACK_INLINE lanes::Mask<F> intersect_cone(lanes::Mask<F> valid, const Quadric
     // lose r0^2 to cancellation (the re-centring of Haines et al., "Precision
     // Improvements for Ray/Sphere Intersection", Ray Tracing Gems ch. 7).
     // Any t_mid near the projection works: the roots are relative to it.
-    const F t_mid = lanes::dot(lanes::sub(cone.mid, org), dir) * ray.inv_dd;
-    const Vec3<F> co = {lanes::fma(dir.x, t_mid, org.x) - cone.base.x, lanes::fma(dir.y, t_mid, org.y) - cone.base.y,
-                        lanes::fma(dir.z, t_mid, org.z) - cone.base.z};
+    const F t_mid = fused_dot((cone.mid - org), dir) * ray.inv_dd;
+    const Vec3<F> co = {vfmadd(dir.x, t_mid, org.x) - cone.base.x, vfmadd(dir.y, t_mid, org.y) - cone.base.y,
+                        vfmadd(dir.z, t_mid, org.z) - cone.base.z};
     // Work with the components perpendicular to the axis, so that nothing
     // large is squared and then subtracted.
-    const F s0 = lanes::dot(co, cone.w);   // axial position of the (moved) origin
-    const F ds = lanes::dot(dir, cone.w);  // axial speed
-    const Vec3<F> co_perp = lanes::sub_scaled(co, cone.w, s0);
-    const Vec3<F> d_perp = lanes::sub_scaled(dir, cone.w, ds);
-    const F r0 = lanes::fma(cone.k, s0, cone.rb);
+    const F s0 = fused_dot(co, cone.w);   // axial position of the (moved) origin
+    const F ds = fused_dot(dir, cone.w);  // axial speed
+    const Vec3<F> co_perp = fused_sub_scaled(co, cone.w, s0);
+    const Vec3<F> d_perp = fused_sub_scaled(dir, cone.w, ds);
+    const F r0 = vfmadd(cone.k, s0, cone.rb);
     const F kds = cone.k * ds;
     // a t^2 + 2 b t + c = 0 in t relative to t_mid.
-    const F a = lanes::fnma(kds, kds, lanes::dot(d_perp, d_perp));
-    const F b = lanes::fnma(r0, kds, lanes::dot(co_perp, d_perp));
-    const F c = lanes::fnma(r0, r0, lanes::dot(co_perp, co_perp));
-    const F disc = lanes::fms(b, b, a * c);
+    const F a = vfnmadd(kds, kds, fused_dot(d_perp, d_perp));
+    const F b = vfnmadd(r0, kds, fused_dot(co_perp, d_perp));
+    const F c = vfnmadd(r0, r0, fused_dot(co_perp, co_perp));
+    const F disc = vfmsub(b, b, a * c);
     valid = valid & (disc >= F(0));
     if (none(valid)) return valid;
     // Stable root pair (Press et al., Numerical Recipes 5.6). q == 0 only
@@ -77,16 +77,16 @@ RAYPACK_INLINE lanes::Mask<F> intersect_cone(lanes::Mask<F> valid, const Quadric
     // twice. a == 0 (parallel to a generator line) leaves the one crossing
     // c / q = -c / 2b and q / a = +-inf, which fails the end test; with
     // b == 0 as well (along a cylinder's axis) both are NaN.
-    const F q = -(b + lanes::copysign(lanes::sqrt(disc), b));
+    const F q = -(b + copysign_of(vsqrt(disc), b));
     const F t_q = q / a, t_c = c / q;
     const F lo = vmin(t_c, t_q), hi = vmax(t_c, t_q);
     // A root counts when it is within [tnear, tfar] and between the ends.
     const F t_lo = t_mid + lo, t_hi = t_mid + hi;
-    const F s_lo = lanes::fma(lo, ds, s0), s_hi = lanes::fma(hi, ds, s0);
-    const lanes::Mask<F> in_lo = (t_lo >= ray.tnear) & (t_lo <= ray.tfar) & (s_lo >= F(0)) & (s_lo <= cone.h) &
-                                 (lanes::fma(cone.k, s_lo, cone.rb) >= F(0));
-    const lanes::Mask<F> in_hi = (t_hi >= ray.tnear) & (t_hi <= ray.tfar) & (s_hi >= F(0)) & (s_hi <= cone.h) &
-                                 (lanes::fma(cone.k, s_hi, cone.rb) >= F(0));
+    const F s_lo = vfmadd(lo, ds, s0), s_hi = vfmadd(hi, ds, s0);
+    const mask_of<F> in_lo = (t_lo >= ray.tnear) & (t_lo <= ray.tfar) & (s_lo >= F(0)) & (s_lo <= cone.h) &
+                                 (vfmadd(cone.k, s_lo, cone.rb) >= F(0));
+    const mask_of<F> in_hi = (t_hi >= ray.tnear) & (t_hi <= ray.tfar) & (s_hi >= F(0)) & (s_hi <= cone.h) &
+                                 (vfmadd(cone.k, s_hi, cone.rb) >= F(0));
     t = select(in_lo, t_lo, t_hi);
     s_frac = select(in_lo, s_lo, s_hi) * cone.inv_h;
     return valid & (in_lo | in_hi);
@@ -94,7 +94,7 @@ RAYPACK_INLINE lanes::Mask<F> intersect_cone(lanes::Mask<F> valid, const Quadric
 
 /// The same from the ray's fields.
 template <class F>
-RAYPACK_INLINE lanes::Mask<F> intersect_cone(lanes::Mask<F> valid, const Vec3<F>& org, const Vec3<F>& dir,
+RAYPACK_INLINE mask_of<F> intersect_cone(mask_of<F> valid, const Vec3<F>& org, const Vec3<F>& dir,
                                              const F& tnear, const F& tfar, const ConeLanes<F>& cone, F& t,
                                              F& s_frac) {
     return intersect_cone<F>(valid, make_quadric_ray<F>(org, dir, tnear, tfar), cone, t, s_frac);
@@ -102,7 +102,7 @@ RAYPACK_INLINE lanes::Mask<F> intersect_cone(lanes::Mask<F> valid, const Vec3<F>
 
 /// The same from the ray's fields and the cone's end points.
 template <class F>
-RAYPACK_INLINE lanes::Mask<F> intersect_cone(lanes::Mask<F> valid, const Vec3<F>& org, const Vec3<F>& dir,
+RAYPACK_INLINE mask_of<F> intersect_cone(mask_of<F> valid, const Vec3<F>& org, const Vec3<F>& dir,
                                              const F& tnear, const F& tfar, const Vec3<F>& base,
                                              const F& base_radius, const Vec3<F>& apex, const F& apex_radius, F& t,
                                              F& s_frac) {

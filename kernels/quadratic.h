@@ -6,82 +6,12 @@
 #include <type_traits>
 #include <utility>
 
+#include "kernels/fused.h"
 #include "kernels/simd.h"
 #include "kernels/vec3.h"
 
 namespace raypack {
 
-namespace lanes {
-
-template <class F> struct MaskType { using type = mask_of<F>; };
-template <> struct MaskType<long double> { using type = bool; };
-
-/// Mask of lane type F: bool for float, double and long double.
-template <class F> using Mask = typename MaskType<F>::type;
-
-template <class F>
-RAYPACK_INLINE F fma(const F& a, const F& b, const F& c) {
-    if constexpr (std::is_same_v<F, long double>) return std::fma(a, b, c);
-    else return vfmadd(a, b, c);
-}
-/// c - a * b and a * b - c with one rounding: the same values as fma(-a, b, c)
-/// and fma(a, b, -c), without the negation (vfnmadd / vfmsub).
-template <class F>
-RAYPACK_INLINE F fnma(const F& a, const F& b, const F& c) {
-    if constexpr (std::is_floating_point_v<F>) return std::fma(-a, b, c);
-    else if constexpr (sizeof(F) == 16) return _mm_fnmadd_ps(a, b, c);
-    else if constexpr (sizeof(F) == 32) return _mm256_fnmadd_ps(a, b, c);
-#if defined(__AVX512F__)
-    else if constexpr (sizeof(F) == 64) return _mm512_fnmadd_ps(a, b, c);
-#endif
-    else static_assert(sizeof(F) == 0, "fnma: unsupported width");
-}
-template <class F>
-RAYPACK_INLINE F fms(const F& a, const F& b, const F& c) {
-    if constexpr (std::is_floating_point_v<F>) return std::fma(a, b, -c);
-    else if constexpr (sizeof(F) == 16) return _mm_fmsub_ps(a, b, c);
-    else if constexpr (sizeof(F) == 32) return _mm256_fmsub_ps(a, b, c);
-#if defined(__AVX512F__)
-    else if constexpr (sizeof(F) == 64) return _mm512_fmsub_ps(a, b, c);
-#endif
-    else static_assert(sizeof(F) == 0, "fms: unsupported width");
-}
-template <class F>
-RAYPACK_INLINE F sqrt(const F& x) {
-    if constexpr (std::is_same_v<F, long double>) return std::sqrt(x);
-#if defined(__AVX512F__)
-    // gcc 12's _mm512_sqrt_ps passes _mm512_undefined_ps() through, which
-    // -Wmaybe-uninitialized reports; the all-lanes masked form is the same
-    // instruction.
-    else if constexpr (sizeof(F) == 64) return _mm512_mask_sqrt_ps(x, __mmask16(0xFFFF), x);
-#endif
-    else return vsqrt(x);
-}
-template <class F>
-RAYPACK_INLINE F copysign(const F& x, const F& s) {
-    if constexpr (std::is_same_v<F, long double>) return std::copysign(x, s);
-    else return copysign_of(x, s);
-}
-
-/// a . b as one multiply and two fused multiply-adds (one instruction fewer
-/// than three products and two sums, and no rounding of two of the products).
-template <class F>
-RAYPACK_INLINE F dot(const Vec3<F>& a, const Vec3<F>& b) {
-    return lanes::fma(a.x, b.x, lanes::fma(a.y, b.y, a.z * b.z));
-}
-
-/// a - b * s, per component, fused.
-template <class F>
-RAYPACK_INLINE Vec3<F> sub_scaled(const Vec3<F>& a, const Vec3<F>& b, const F& s) {
-    return {lanes::fnma(b.x, s, a.x), lanes::fnma(b.y, s, a.y), lanes::fnma(b.z, s, a.z)};
-}
-
-template <class F>
-RAYPACK_INLINE Vec3<F> sub(const Vec3<F>& a, const Vec3<F>& b) {
-    return {a.x - b.x, a.y - b.y, a.z - b.z};
-}
-
-}  // namespace lanes
 
 /// What the sphere and cone tests need of a ray, computed once per ray like
 /// the slab test's reciprocal direction: |dir|^2 (the t^2 coefficient of
@@ -96,11 +26,9 @@ struct QuadricRay {
 
 template <class F>
 RAYPACK_INLINE QuadricRay<F> make_quadric_ray(const Vec3<F>& org, const Vec3<F>& dir, const F& tnear, const F& tfar) {
-    const F dd = lanes::dot(dir, dir);
+    const F dd = fused_dot(dir, dir);
     return {org, dir, tnear, tfar, dd, F(1) / dd};
 }
-
-namespace lanes {
 
 /// The nearer of two roots lo <= hi inside [tnear, tfar]: narrows `valid` to
 /// the lanes that have one and writes it to `t` (every lane; meaningful on
@@ -108,12 +36,10 @@ namespace lanes {
 /// past tnear (then hi, further still, cannot be in when lo is past tfar);
 /// otherwise hi is.
 template <class F>
-RAYPACK_INLINE Mask<F> nearest_root(Mask<F> valid, const F& lo, const F& hi, const F& tnear, const F& tfar, F& t) {
+RAYPACK_INLINE mask_of<F> nearest_root(mask_of<F> valid, const F& lo, const F& hi, const F& tnear, const F& tfar, F& t) {
     t = select(lo >= tnear, lo, hi);
     return valid & (t >= tnear) & (t <= tfar);
 }
-
-}  // namespace lanes
 
 /// Numerically stable roots (Press et al., Numerical Recipes 5.6): the root
 /// that would suffer cancellation is taken from the product of the roots.

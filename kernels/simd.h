@@ -70,6 +70,8 @@ template <class F> struct LaneTraits {  // xsimd batches
 };
 template <> struct LaneTraits<float> { using Mask = bool; static constexpr int width = 1; };
 template <> struct LaneTraits<double> { using Mask = bool; static constexpr int width = 1; };
+/// long double: scalar only, for high-precision references in tests.
+template <> struct LaneTraits<long double> { using Mask = bool; static constexpr int width = 1; };
 template <class F> using mask_of = typename LaneTraits<F>::Mask;
 template <class F> inline constexpr int lanes_of = LaneTraits<F>::width;
 
@@ -87,10 +89,23 @@ template <class A> RAYPACK_INLINE bool all(const xsimd::batch_bool<float, A>& m)
 template <class T, std::enable_if_t<std::is_floating_point_v<T>, int> = 0>
 RAYPACK_INLINE T select(bool m, T a, T b) { return m ? a : b; }
 RAYPACK_INLINE bool select(bool m, bool a, bool b) { return m ? a : b; }
+/// For 4 and 8 lanes on AVX-512VL machines one vpternlogd on the vector
+/// mask: gcc otherwise turns xsimd's blendv into a compare into a mask
+/// register plus a masked move, and that compare (like vblendvps) takes a
+/// slot on the two multiply/FMA pipes the kernels saturate. Same bits.
 template <class A>
 RAYPACK_INLINE xsimd::batch<float, A> select(const xsimd::batch_bool<float, A>& m, const xsimd::batch<float, A>& a,
-                              const xsimd::batch<float, A>& b) {
-    return xsimd::select(m, a, b);
+                                             const xsimd::batch<float, A>& b) {
+#if defined(__AVX512VL__)
+    if constexpr (sizeof(a) == 16)
+        return _mm_castsi128_ps(
+            _mm_ternarylogic_epi32(_mm_castps_si128(m), _mm_castps_si128(a), _mm_castps_si128(b), 0xCA));
+    else if constexpr (sizeof(a) == 32)
+        return _mm256_castsi256_ps(
+            _mm256_ternarylogic_epi32(_mm256_castps_si256(m), _mm256_castps_si256(a), _mm256_castps_si256(b), 0xCA));
+    else
+#endif
+        return xsimd::select(m, a, b);
 }
 
 // x86 minps/maxps return the second operand when the comparison is
@@ -132,6 +147,7 @@ RAYPACK_INLINE xsimd::batch<float, A> vmax(const xsimd::batch<float, A>& a, cons
 /// fusion; the build forbids implicit contraction (see CMakeLists.txt).
 RAYPACK_INLINE float vfmadd(float a, float b, float c) { return std::fma(a, b, c); }
 RAYPACK_INLINE double vfmadd(double a, double b, double c) { return std::fma(a, b, c); }
+RAYPACK_INLINE long double vfmadd(long double a, long double b, long double c) { return std::fma(a, b, c); }
 #if defined(__FMA__)
 template <class A>
 RAYPACK_INLINE xsimd::batch<float, A> vfmadd(const xsimd::batch<float, A>& a, const xsimd::batch<float, A>& b,
@@ -148,6 +164,7 @@ RAYPACK_INLINE xsimd::batch<float, A> vfmadd(const xsimd::batch<float, A>& a, co
 /// Fused a * b - c with one rounding (vfmsub; no negation of c).
 RAYPACK_INLINE float vfmsub(float a, float b, float c) { return std::fma(a, b, -c); }
 RAYPACK_INLINE double vfmsub(double a, double b, double c) { return std::fma(a, b, -c); }
+RAYPACK_INLINE long double vfmsub(long double a, long double b, long double c) { return std::fma(a, b, -c); }
 #if defined(__FMA__)
 template <class A>
 RAYPACK_INLINE xsimd::batch<float, A> vfmsub(const xsimd::batch<float, A>& a, const xsimd::batch<float, A>& b,
@@ -161,16 +178,45 @@ RAYPACK_INLINE xsimd::batch<float, A> vfmsub(const xsimd::batch<float, A>& a, co
 }
 #endif
 
+/// Fused c - a * b with one rounding (vfnmadd; no negation of a).
+RAYPACK_INLINE float vfnmadd(float a, float b, float c) { return std::fma(-a, b, c); }
+RAYPACK_INLINE double vfnmadd(double a, double b, double c) { return std::fma(-a, b, c); }
+RAYPACK_INLINE long double vfnmadd(long double a, long double b, long double c) { return std::fma(-a, b, c); }
+#if defined(__FMA__)
+template <class A>
+RAYPACK_INLINE xsimd::batch<float, A> vfnmadd(const xsimd::batch<float, A>& a, const xsimd::batch<float, A>& b,
+                                              const xsimd::batch<float, A>& c) {
+    if constexpr (sizeof(a) == 16) return _mm_fnmadd_ps(a, b, c);
+    else if constexpr (sizeof(a) == 32) return _mm256_fnmadd_ps(a, b, c);
+#if defined(__AVX512F__)
+    else if constexpr (sizeof(a) == 64) return _mm512_fnmadd_ps(a, b, c);
+#endif
+    else static_assert(sizeof(A) == 0, "vfnmadd: unsupported width");
+}
+#endif
+
 RAYPACK_INLINE float vsqrt(float x) { return std::sqrt(x); }
 RAYPACK_INLINE double vsqrt(double x) { return std::sqrt(x); }
-template <class A> RAYPACK_INLINE xsimd::batch<float, A> vsqrt(const xsimd::batch<float, A>& x) { return xsimd::sqrt(x); }
+RAYPACK_INLINE long double vsqrt(long double x) { return std::sqrt(x); }
+template <class A>
+RAYPACK_INLINE xsimd::batch<float, A> vsqrt(const xsimd::batch<float, A>& x) {
+#if defined(__AVX512F__)
+    // The all-lanes masked form is the same vsqrtps, without the undefined
+    // pass-through operand gcc 12 warns about.
+    if constexpr (sizeof(x) == 64) return _mm512_mask_sqrt_ps(x, __mmask16(0xFFFF), x);
+    else
+#endif
+        return xsimd::sqrt(x);
+}
 RAYPACK_INLINE float vabs(float x) { return std::fabs(x); }
 RAYPACK_INLINE double vabs(double x) { return std::fabs(x); }
+RAYPACK_INLINE long double vabs(long double x) { return std::fabs(x); }
 template <class A> RAYPACK_INLINE xsimd::batch<float, A> vabs(const xsimd::batch<float, A>& x) { return xsimd::abs(x); }
 
 /// Copy the sign of `s` onto `x` (works for -0).
 RAYPACK_INLINE float copysign_of(float x, float s) { return std::copysign(x, s); }
 RAYPACK_INLINE double copysign_of(double x, double s) { return std::copysign(x, s); }
+RAYPACK_INLINE long double copysign_of(long double x, long double s) { return std::copysign(x, s); }
 template <class A>
 RAYPACK_INLINE xsimd::batch<float, A> copysign_of(const xsimd::batch<float, A>& x, const xsimd::batch<float, A>& s) {
     return xsimd::copysign(x, s);

@@ -19,17 +19,17 @@ enum class SphereMethod { Algebraic, Geometric, Precise };
 /// far away (cancellation in b^2 - ac); kept as the baseline the other
 /// methods are measured against.
 template <class F>
-RAYPACK_INLINE lanes::Mask<F> intersect_sphere_algebraic(lanes::Mask<F> valid, const QuadricRay<F>& ray,
+RAYPACK_INLINE mask_of<F> intersect_sphere_algebraic(mask_of<F> valid, const QuadricRay<F>& ray,
                                                          const Vec3<F>& center, const F& radius, F& t) {
-    const Vec3<F> oc = lanes::sub(ray.org, center);
-    const F b = lanes::dot(oc, ray.dir);
-    const F c = lanes::dot(oc, oc) - radius * radius;
-    const F disc = lanes::fms(b, b, ray.dd * c);
+    const Vec3<F> oc = (ray.org - center);
+    const F b = fused_dot(oc, ray.dir);
+    const F c = fused_dot(oc, oc) - radius * radius;
+    const F disc = vfmsub(b, b, ray.dd * c);
     valid = valid & (disc >= F(0));
     if (none(valid)) return valid;
-    const F root = lanes::sqrt(disc);
+    const F root = vsqrt(disc);
     const F nb = -b;
-    return lanes::nearest_root(valid, (nb - root) * ray.inv_dd, (nb + root) * ray.inv_dd, ray.tnear, ray.tfar, t);
+    return nearest_root(valid, (nb - root) * ray.inv_dd, (nb + root) * ray.inv_dd, ray.tnear, ray.tfar, t);
 }
 
 /// Geometric method (Haines, "Essential Ray Tracing Algorithms", in Glassner,
@@ -37,17 +37,17 @@ RAYPACK_INLINE lanes::Mask<F> intersect_sphere_algebraic(lanes::Mask<F> valid, c
 /// use the squared distance of the centre from the ray, which avoids
 /// subtracting two large nearly-equal numbers.
 template <class F>
-RAYPACK_INLINE lanes::Mask<F> intersect_sphere_geometric(lanes::Mask<F> valid, const QuadricRay<F>& ray,
+RAYPACK_INLINE mask_of<F> intersect_sphere_geometric(mask_of<F> valid, const QuadricRay<F>& ray,
                                                          const Vec3<F>& center, const F& radius, F& t) {
-    const Vec3<F> l = lanes::sub(center, ray.org);
-    const F tca = lanes::dot(l, ray.dir) * ray.inv_dd;        // closest approach along the ray
-    const Vec3<F> perp = lanes::sub_scaled(l, ray.dir, tca);  // centre minus closest point
-    const F d2 = lanes::dot(perp, perp);                      // squared distance centre-ray
+    const Vec3<F> l = (center - ray.org);
+    const F tca = fused_dot(l, ray.dir) * ray.inv_dd;        // closest approach along the ray
+    const Vec3<F> perp = fused_sub_scaled(l, ray.dir, tca);  // centre minus closest point
+    const F d2 = fused_dot(perp, perp);                      // squared distance centre-ray
     const F r2 = radius * radius;
     valid = valid & (d2 <= r2);
     if (none(valid)) return valid;
-    const F thc = lanes::sqrt((r2 - d2) * ray.inv_dd);
-    return lanes::nearest_root(valid, tca - thc, tca + thc, ray.tnear, ray.tfar, t);
+    const F thc = vsqrt((r2 - d2) * ray.inv_dd);
+    return nearest_root(valid, tca - thc, tca + thc, ray.tnear, ray.tfar, t);
 }
 
 /// Haines, Guenther, Akenine-Moeller, "Precision Improvements for Ray/Sphere
@@ -57,27 +57,27 @@ RAYPACK_INLINE lanes::Mask<F> intersect_sphere_geometric(lanes::Mask<F> valid, c
 /// terms), and the roots are the stable pair q / a, c / q with
 /// q = -(b + sign(b) sqrt(b^2 - ac)) (Press et al., Numerical Recipes 5.6).
 template <class F>
-RAYPACK_INLINE lanes::Mask<F> intersect_sphere_precise(lanes::Mask<F> valid, const QuadricRay<F>& ray,
+RAYPACK_INLINE mask_of<F> intersect_sphere_precise(mask_of<F> valid, const QuadricRay<F>& ray,
                                                        const Vec3<F>& center, const F& radius, F& t) {
-    const Vec3<F> f = lanes::sub(ray.org, center);
-    const F b = lanes::dot(f, ray.dir);
-    const Vec3<F> l = lanes::sub_scaled(f, ray.dir, b * ray.inv_dd);  // f minus its projection on the ray
+    const Vec3<F> f = (ray.org - center);
+    const F b = fused_dot(f, ray.dir);
+    const Vec3<F> l = fused_sub_scaled(f, ray.dir, b * ray.inv_dd);  // f minus its projection on the ray
     const F r2 = radius * radius;
-    const F h2 = r2 - lanes::dot(l, l);  // discriminant / a
+    const F h2 = r2 - fused_dot(l, l);  // discriminant / a
     valid = valid & (h2 >= F(0));
     if (none(valid)) return valid;
     // c with the same r2 as h2: then h2 == 0 with b == 0 (a tangent ray from
     // the surface) gives c == 0 and the 0 / 0 below is dropped by vmin/vmax.
-    const F c = lanes::dot(f, f) - r2;
-    const F q = -(b + lanes::copysign(lanes::sqrt(ray.dd * h2), b));
+    const F c = fused_dot(f, f) - r2;
+    const F q = -(b + copysign_of(vsqrt(ray.dd * h2), b));
     const F t_q = q * ray.inv_dd, t_c = c / q;
     // vmin/vmax return the second operand when the first is NaN (q == 0).
-    return lanes::nearest_root(valid, vmin(t_c, t_q), vmax(t_c, t_q), ray.tnear, ray.tfar, t);
+    return nearest_root(valid, vmin(t_c, t_q), vmax(t_c, t_q), ray.tnear, ray.tfar, t);
 }
 
 /// The variant chosen at compile time.
 template <SphereMethod Method, class F>
-RAYPACK_INLINE lanes::Mask<F> intersect_sphere(lanes::Mask<F> valid, const QuadricRay<F>& ray, const Vec3<F>& center,
+RAYPACK_INLINE mask_of<F> intersect_sphere(mask_of<F> valid, const QuadricRay<F>& ray, const Vec3<F>& center,
                                                const F& radius, F& t) {
     if constexpr (Method == SphereMethod::Algebraic)
         return intersect_sphere_algebraic<F>(valid, ray, center, radius, t);
@@ -89,25 +89,25 @@ RAYPACK_INLINE lanes::Mask<F> intersect_sphere(lanes::Mask<F> valid, const Quadr
 
 /// The same from the ray's fields (computes |dir|^2 and its reciprocal).
 template <SphereMethod Method, class F>
-RAYPACK_INLINE lanes::Mask<F> intersect_sphere(lanes::Mask<F> valid, const Vec3<F>& org, const Vec3<F>& dir,
+RAYPACK_INLINE mask_of<F> intersect_sphere(mask_of<F> valid, const Vec3<F>& org, const Vec3<F>& dir,
                                                const F& tnear, const F& tfar, const Vec3<F>& center, const F& radius,
                                                F& t) {
     return intersect_sphere<Method, F>(valid, make_quadric_ray<F>(org, dir, tnear, tfar), center, radius, t);
 }
 template <class F>
-RAYPACK_INLINE lanes::Mask<F> intersect_sphere_algebraic(lanes::Mask<F> valid, const Vec3<F>& org, const Vec3<F>& dir,
+RAYPACK_INLINE mask_of<F> intersect_sphere_algebraic(mask_of<F> valid, const Vec3<F>& org, const Vec3<F>& dir,
                                                          const F& tnear, const F& tfar, const Vec3<F>& center,
                                                          const F& radius, F& t) {
     return intersect_sphere<SphereMethod::Algebraic, F>(valid, org, dir, tnear, tfar, center, radius, t);
 }
 template <class F>
-RAYPACK_INLINE lanes::Mask<F> intersect_sphere_geometric(lanes::Mask<F> valid, const Vec3<F>& org, const Vec3<F>& dir,
+RAYPACK_INLINE mask_of<F> intersect_sphere_geometric(mask_of<F> valid, const Vec3<F>& org, const Vec3<F>& dir,
                                                          const F& tnear, const F& tfar, const Vec3<F>& center,
                                                          const F& radius, F& t) {
     return intersect_sphere<SphereMethod::Geometric, F>(valid, org, dir, tnear, tfar, center, radius, t);
 }
 template <class F>
-RAYPACK_INLINE lanes::Mask<F> intersect_sphere_precise(lanes::Mask<F> valid, const Vec3<F>& org, const Vec3<F>& dir,
+RAYPACK_INLINE mask_of<F> intersect_sphere_precise(mask_of<F> valid, const Vec3<F>& org, const Vec3<F>& dir,
                                                        const F& tnear, const F& tfar, const Vec3<F>& center,
                                                        const F& radius, F& t) {
     return intersect_sphere<SphereMethod::Precise, F>(valid, org, dir, tnear, tfar, center, radius, t);

@@ -17,6 +17,7 @@
 #include <type_traits>
 
 #include "kernels/ray.h"
+#include "kernels/fused.h"
 #include "kernels/simd.h"
 
 namespace raypack {
@@ -24,18 +25,6 @@ namespace raypack {
 enum class TriangleMethod { Moeller, Watertight, Plane };
 
 namespace triangle_detail {
-
-/// a x b, each component one product and one fused multiply-subtract.
-template <class F>
-RAYPACK_INLINE Vec3<F> fcross(const Vec3<F>& a, const Vec3<F>& b) {
-    return {vfmsub(a.y, b.z, a.z * b.y), vfmsub(a.z, b.x, a.x * b.z), vfmsub(a.x, b.y, a.y * b.x)};
-}
-
-/// a . b as one product and two fused multiply-adds.
-template <class F>
-RAYPACK_INLINE F fdot(const Vec3<F>& a, const Vec3<F>& b) {
-    return vfmadd(a.x, b.x, vfmadd(a.y, b.y, a.z * b.z));
-}
 
 /// The sign bit of s alone (+0 or -0 per lane).
 template <class F>
@@ -59,27 +48,6 @@ RAYPACK_INLINE F flip_sign(const F& x, const F& sign) {
     } else {
         return x ^ sign;
     }
-}
-
-/// m ? a : b per lane, bit for bit the same as select(). For 4 and 8 lanes
-/// on AVX-512VL machines it is one vpternlogd on the vector mask: gcc turns
-/// xsimd's blendv into a vector-to-mask-register compare plus a masked move,
-/// and that compare (like vblendvps itself) takes a slot on the two
-/// multiply/FMA ports, which the kernels saturate; vpternlogd does not.
-template <class F>
-RAYPACK_INLINE F blend(const mask_of<F>& m, const F& a, const F& b) {
-#if defined(__AVX512VL__)
-    if constexpr (!std::is_floating_point_v<F>) {
-        if constexpr (sizeof(F) == 16) {
-            return _mm_castsi128_ps(_mm_ternarylogic_epi32(_mm_castps_si128(m), _mm_castps_si128(a),
-                                                           _mm_castps_si128(b), 0xCA));
-        } else if constexpr (sizeof(F) == 32) {
-            return _mm256_castsi256_ps(_mm256_ternarylogic_epi32(_mm256_castps_si256(m), _mm256_castps_si256(a),
-                                                                 _mm256_castps_si256(b), 0xCA));
-        }
-    }
-#endif
-    return select(m, a, b);
 }
 
 /// The least |det| a kernel divides by: the smallest normal number, so that
@@ -114,13 +82,13 @@ RAYPACK_INLINE mask_of<F> intersect_triangle_moeller(mask_of<F> valid, const Vec
                                                      const Vec3<F>& p1, const Vec3<F>& p2, F& t, F& u, F& v) {
     const Vec3<F> e1n = p0 - p1;  // -e1
     const Vec3<F> e2 = p2 - p0;
-    const Vec3<F> ng = triangle_detail::fcross(e1n, e2);  // e2 x e1
+    const Vec3<F> ng = fused_cross(e1n, e2);  // e2 x e1
     return intersect_triangle_moeller_edges<F>(valid, org, dir, tnear, tfar, p0, e1n, e2, ng, t, u, v);
 }
 
 /// The per-ray part of intersect_triangle_moeller, for triangles stored with
-/// their edges e1n = p0 - p1, e2 = p2 - p0 and ng = fcross(e1n, e2)
-/// (triangle_detail::fcross, so that the results are the same bit for bit).
+/// their edges e1n = p0 - p1, e2 = p2 - p0 and ng = fused_cross(e1n, e2)
+/// (fused_cross, so that the results are the same bit for bit).
 template <class F>
 RAYPACK_INLINE mask_of<F> intersect_triangle_moeller_edges(mask_of<F> valid, const Vec3<F>& org,
                                                            const Vec3<F>& dir, const F& tnear, const F& tfar,
@@ -129,15 +97,15 @@ RAYPACK_INLINE mask_of<F> intersect_triangle_moeller_edges(mask_of<F> valid, con
                                                            F& v) {
     using namespace triangle_detail;
     const Vec3<F> w = p0 - org;        // -tvec
-    const Vec3<F> s = fcross(dir, w);  // tvec x d
-    const F det = fdot(dir, ng);
-    const F U = fdot(e2, s);
-    const F V = fdot(e1n, s);
+    const Vec3<F> s = fused_cross(dir, w);  // tvec x d
+    const F det = fused_dot(dir, ng);
+    const F U = fused_dot(e2, s);
+    const F V = fused_dot(e1n, s);
     const F sign = sign_bit(det), abs_det = vabs(det);
     const F Us = flip_sign(U, sign), Vs = flip_sign(V, sign);
     valid = valid & (abs_det >= F(kMinDet<F>)) & (Us >= F(0)) & (Vs >= F(0)) & (Us + Vs <= abs_det);
     if (none(valid)) return valid;
-    const F T = fdot(w, ng);
+    const F T = fused_dot(w, ng);
     const F inv_det = F(1) / det;
     t = T * inv_det;
     valid = valid & (t >= tnear) & (t <= tfar);
@@ -168,8 +136,8 @@ namespace triangle_detail {
 /// p in the frame (kx, ky, kz), kz given per lane by the masks.
 template <class F>
 RAYPACK_INLINE Vec3<F> to_ray_axes(const mask_of<F>& kz_x, const mask_of<F>& kz_y, const Vec3<F>& p) {
-    return {blend(kz_x, p.y, blend(kz_y, p.z, p.x)), blend(kz_x, p.z, blend(kz_y, p.x, p.y)),
-            blend(kz_x, p.x, blend(kz_y, p.y, p.z))};
+    return {select(kz_x, p.y, select(kz_y, p.z, p.x)), select(kz_x, p.z, select(kz_y, p.x, p.y)),
+            select(kz_x, p.x, select(kz_y, p.y, p.z))};
 }
 
 /// p in the frame (kx, ky, kz) for kz = Z in every lane.
@@ -294,18 +262,18 @@ RAYPACK_INLINE mask_of<F> intersect_triangle_plane(mask_of<F> valid, const Vec3<
     using namespace triangle_detail;
     const Vec3<F> e1 = p1 - p0;
     const Vec3<F> e2 = p2 - p0;
-    const Vec3<F> n = fcross(e1, e2);
-    const F nn = fdot(n, n);
-    const Vec3<F> n1 = fcross(e2, n), n2 = fcross(n, e1);
-    const F denom = fdot(n, dir);
+    const Vec3<F> n = fused_cross(e1, e2);
+    const F nn = fused_dot(n, n);
+    const Vec3<F> n1 = fused_cross(e2, n), n2 = fused_cross(n, e1);
+    const F denom = fused_dot(n, dir);
     const Vec3<F> w = p0 - org;
-    t = fdot(n, w) / denom;
+    t = fused_dot(n, w) / denom;
     valid = valid & (vabs(denom) >= F(kMinDet<F>)) & (t >= tnear) & (t <= tfar);
     if (none(valid)) return valid;
     // q = o + t d - p0, the hit point relative to p0; q = U e1 + V e2 with
     // U = q . n1 / |n|^2, V = q . n2 / |n|^2.
     const Vec3<F> q{vfmsub(dir.x, t, w.x), vfmsub(dir.y, t, w.y), vfmsub(dir.z, t, w.z)};
-    const F U = fdot(q, n1), V = fdot(q, n2);
+    const F U = fused_dot(q, n1), V = fused_dot(q, n2);
     valid = valid & (U >= F(0)) & (V >= F(0)) & (U + V <= nn);
     const F inv_nn = F(1) / nn;
     u = U * inv_nn;

@@ -81,8 +81,8 @@ TEST_P(Bvh2Packet, EqualsSingleRayTraversal) {
 INSTANTIATE_TEST_SUITE_P(SharedScenes, Bvh2Packet,
                          ::testing::Values("balls.nff", "gears.nff", "mount.nff", "rings.nff", "teapot.nff",
                                            "tetra.nff", "tree.nff"),
-                         [](const auto& info) {
-                             std::string name = info.param;
+                         [](const auto& test_info) {
+                             std::string name = test_info.param;
                              return name.substr(0, name.find('.'));
                          });
 

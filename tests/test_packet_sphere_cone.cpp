@@ -469,7 +469,7 @@ struct SphereKernel {
         return {Vec3<T>(p.center), T(p.radius)};
     }
     template <class F>
-    static lanes::Mask<F> run(lanes::Mask<F> valid, const RayT<F>& r, const Lanes<F>& p, F& t, F& s) {
+    static mask_of<F> run(mask_of<F> valid, const RayT<F>& r, const Lanes<F>& p, F& t, F& s) {
         s = F(0);
         return intersect_sphere<M, F>(valid, r.org, r.dir, r.tnear, r.tfar, p.center, p.radius, t);
     }
@@ -496,7 +496,7 @@ struct ConeKernel {
         return make_cone<T>(Vec3<T>(p.base), T(p.rb), Vec3<T>(p.apex), T(p.ra));
     }
     template <class F>
-    static lanes::Mask<F> run(lanes::Mask<F> valid, const RayT<F>& r, const Lanes<F>& p, F& t, F& s) {
+    static mask_of<F> run(mask_of<F> valid, const RayT<F>& r, const Lanes<F>& p, F& t, F& s) {
         return intersect_cone<F>(valid, r.org, r.dir, r.tnear, r.tfar, p, t, s);
     }
 };

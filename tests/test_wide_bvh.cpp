@@ -342,7 +342,7 @@ void check_structure(const raypack::WideBvh<N, M>& bvh, const Scene& scene, cons
                     const TriangleBlock<M>& tb = bvh.triangles[b];
                     const Vec3f p0 = scene.triangles.p0[t], e1n = p0 - scene.triangles.p1[t],
                                 e2 = scene.triangles.p2[t] - p0;
-                    const Vec3f ng = triangle_detail::fcross(e1n, e2);
+                    const Vec3f ng = fused_cross(e1n, e2);
                     for (int a = 0; a < 3; ++a)
                         if (tb.p0[a][j] != p0[a] || tb.a[a][j] != e1n[a] || tb.b[a][j] != e2[a] || tb.ng[a][j] != ng[a])
                             fail("triangle block data differs from the kernel's");

@@ -41,7 +41,7 @@ void pack_triangles(TriangleBlock<M>& block, std::span<const std::uint32_t> prim
             const Vec3f e1n = p0 - p1, e2 = p2 - p0;
             set3(block.a, lane, e1n);
             set3(block.b, lane, e2);
-            set3(block.ng, lane, triangle_detail::fcross(e1n, e2));
+            set3(block.ng, lane, fused_cross(e1n, e2));
         } else {
             set3(block.a, lane, p1);
             set3(block.b, lane, p2);

@@ -78,7 +78,7 @@ RAYPACK_INLINE LeafRay<F> make_leaf_ray(const Rayf& r, TriangleMethod method) {
     l.org = {F(r.org.x), F(r.org.y), F(r.org.z)};
     l.dir = {F(r.dir.x), F(r.dir.y), F(r.dir.z)};
     l.tnear = F(r.tnear);
-    const float dd = lanes::dot(r.dir, r.dir);
+    const float dd = fused_dot(r.dir, r.dir);
     l.dd = F(dd);
     l.inv_dd = F(1.0f / dd);
     if (method == TriangleMethod::Watertight) l.watertight = make_watertight_ray<F>(l.org, l.dir);
@@ -94,15 +94,15 @@ RAYPACK_INLINE mask_of<F> intersect_moeller_edges(const Vec3<F>& org, const Vec3
                                                   const Vec3<F>& e2, const Vec3<F>& ng, F& t, F& u, F& v) {
     using namespace triangle_detail;
     const Vec3<F> w = p0 - org;
-    const Vec3<F> s = fcross(dir, w);
-    const F det = fdot(dir, ng);
-    const F U = fdot(e2, s);
-    const F V = fdot(e1n, s);
+    const Vec3<F> s = fused_cross(dir, w);
+    const F det = fused_dot(dir, ng);
+    const F U = fused_dot(e2, s);
+    const F V = fused_dot(e1n, s);
     const F sign = sign_bit(det), abs_det = vabs(det);
     const F Us = flip_sign(U, sign), Vs = flip_sign(V, sign);
     mask_of<F> valid = (abs_det >= F(kMinDet<F>)) & (Us >= F(0)) & (Vs >= F(0)) & (Us + Vs <= abs_det);
     if (none(valid)) return valid;
-    const F T = fdot(w, ng);
+    const F T = fused_dot(w, ng);
     const F inv_det = F(1) / det;
     t = T * inv_det;
     valid = valid & (t >= tnear) & (t <= tfar);
