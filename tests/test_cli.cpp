@@ -69,7 +69,7 @@ TEST(Cli, GenReproducesTheSpdFile) {
 TEST(Cli, RenderWritesTheImageAndSaysWhere) {
     const fs::path out = temp_dir() / "tetra.png";
     fs::remove(out);
-    const Result r = run("render gen:tetra:3 -o " + out.string() + " --res 64 48 --depth 2 --threads 1");
+    const Result r = run("render gen:tetra:3 -o " + out.string() + " --res 64 48 --depth 2 --threads 1 --packet 4");
     ASSERT_EQ(r.status, 0) << r.output;
     EXPECT_TRUE(fs::exists(out));
     EXPECT_NE(r.output.find("64x48"), std::string::npos) << r.output;
@@ -112,6 +112,9 @@ TEST(Cli, BadFlagsAreUsageErrors) {
         {"render " + scene_path("tetra.nff") + " --depth x", "--depth expects an integer"},
         {"render " + scene_path("tetra.nff") + " --accel octopus", "unknown structure 'octopus'"},
         {"trace " + scene_path("tetra.nff"), "missing --rays"},
+        {"render " + scene_path("tetra.nff") + " --packet 3", "--packet: expected 1, 4, 8 or 16"},
+        {"render " + scene_path("tetra.nff") + " --accel brute --packet 8", "--packet 8: not available for brute"},
+        {"render " + scene_path("tetra.nff") + " --sphere exact", "--sphere: expected geometric, algebraic or precise"},
         {"gen nosuch -o x.nff", "unknown generator 'nosuch'"},
         {"gen balls --size 99 -o x.nff", "--size must be between 1 and"},
         {"frobnicate", "unknown command 'frobnicate'"},
