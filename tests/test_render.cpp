@@ -259,3 +259,28 @@ TEST(Render, ImagesRoundTripThroughPngAndExr) {
 
 }  // namespace
 }  // namespace raypack
+
+namespace raypack {
+namespace {
+
+TEST(Render, PacketPrimaryRaysGiveTheSameImage) {
+    // Packet lanes run the same operations as single rays, so the hits, and
+    // therefore every pixel, are identical.
+    const Scene scene = load_scene("gen:balls:2");
+    const auto accel = build_accel(scene, AccelConfig{});
+    WhittedOptions options;
+    options.width = 67;  // not a multiple of the 4 x 4 blocks or the tiles
+    options.height = 45;
+    Image single, packed;
+    render_whitted(scene, *accel, options, single);
+    for (int width : {4, 8, 16}) {
+        if (!accel->supports_packet(width)) continue;
+        options.packet = width;
+        const RenderStats st = render_whitted(scene, *accel, options, packed);
+        EXPECT_EQ(st.eye_rays, 67u * 45u);
+        EXPECT_EQ(packed.rgb, single.rgb) << "packet width " << width;
+    }
+}
+
+}  // namespace
+}  // namespace raypack
