@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <vector>
 
 namespace raypack {
@@ -64,6 +65,9 @@ public:
     /// Builds the subtree of `voxel` from its sorted events (consumed);
     /// returns its node index.
     std::uint32_t build(std::vector<Event>&& events, std::size_t n, const Box3f& voxel, int depth, KdTree& tree) {
+        // Child indices and leaf counts have 30 bits in a KdNode.
+        if (tree.nodes.size() >= (std::size_t(1) << 30) || n >= (std::size_t(1) << 30))
+            throw std::length_error("kdtree: more than 2^30 nodes or references in a leaf");
         const std::uint32_t index = std::uint32_t(tree.nodes.size());
         tree.nodes.emplace_back();
         tree.depth = std::max(tree.depth, depth);
