@@ -427,6 +427,11 @@ std::vector<Variant> variants() {
     v.push_back(variant<8, 8, NodeTest::Ordered>("bvh8 M=8"));
     v.push_back(variant<4, 4, NodeTest::Robust>("bvh4 robust slabs"));
     v.push_back(variant<8, 4, NodeTest::Robust>("bvh8 robust slabs"));
+    v.push_back({"bvh8 greedy collapse", [](const Scene& s, const AccelConfig& c) {
+                     CollapseConfig cc = WideBvhAccel<8, 4>::collapse_config(c);
+                     cc.method = CollapseMethod::Greedy;
+                     return std::make_unique<WideBvhAccel<8, 4>>(s, c, cc);
+                 }});
     return v;
 }
 

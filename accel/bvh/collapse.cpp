@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <limits>
 
 namespace raypack {
 namespace {
@@ -20,6 +21,13 @@ std::uint32_t blocks_for(const std::array<std::uint32_t, 3>& count) {
     return b;
 }
 
+/// A child slot of a wide node: a binary subtree that becomes either a leaf
+/// or a wide node.
+struct Slot {
+    std::uint32_t node;
+    bool leaf;
+};
+
 template <int N, int M>
 class Collapser {
 public:
@@ -27,7 +35,12 @@ public:
         : bvh_(bvh), scene_(scene), config_(config), out_(out), info_(bvh.nodes.size()) {}
 
     void run() {
-        choose_leaves();
+        gather_info();
+        if (config_.method == CollapseMethod::Greedy) {
+            choose_leaves_greedy();
+        } else {
+            plan_optimal();
+        }
         out_.triangle_layout = config_.triangle_layout;
         out_.nodes.reserve(bvh_.nodes.size() / (N - 1) + 1);
         emit_node(0, 1);
@@ -39,65 +52,158 @@ private:
     const CollapseConfig& config_;
     WideBvh<N, M>& out_;
     std::vector<SubtreeInfo> info_;
+    // Optimal plan: cost_[n * N + i - 1] is the least SAH cost of subtree n
+    // spread over at most i slots; split_ is how many of them go to the left
+    // child (0: no better than i - 1 slots).
+    std::vector<float> cost_;
+    std::vector<std::uint8_t> split_;
+
+    std::uint32_t left(std::uint32_t n) const { return n + 1; }
+    std::uint32_t right(std::uint32_t n) const { return bvh_.nodes[n].first; }
 
     // Children follow their parent in the depth-first layout, so a reverse
-    // sweep sees them first. SAH with the wide costs decides the leaves.
-    void choose_leaves() {
-        std::vector<float> cost(bvh_.nodes.size());
-        const float per_binary_node = config_.node_cost / float(N - 1);
+    // sweep sees them first.
+    void gather_info() {
         for (std::size_t i = bvh_.nodes.size(); i-- > 0;) {
             const Bvh2Node& node = bvh_.nodes[i];
             SubtreeInfo& s = info_[i];
-            const float area = node.box.half_area();
             if (node.is_leaf()) {
                 s.begin = node.first;
                 s.end = node.first + node.count;
                 for (std::uint32_t k = s.begin; k < s.end; ++k)
                     ++s.count[std::size_t(scene_.prims[bvh_.prim_index[k]].kind)];
-                s.leaf = true;
-                cost[i] = config_.block_cost * float(blocks_for<M>(s.count)) * area;
                 continue;
             }
-            const std::size_t l = i + 1, r = node.first;
-            s.begin = info_[l].begin;
-            s.end = info_[r].end;
-            for (int k = 0; k < 3; ++k) s.count[k] = info_[l].count[k] + info_[r].count[k];
-            const float inner = per_binary_node * area + cost[l] + cost[r];
-            cost[i] = inner;
-            if (s.end - s.begin <= std::uint32_t(config_.max_leaf_prims)) {
-                const float leaf = config_.block_cost * float(blocks_for<M>(s.count)) * area;
-                if (leaf <= inner) {
-                    s.leaf = true;
-                    cost[i] = leaf;
+            const SubtreeInfo &l = info_[i + 1], &r = info_[node.first];
+            s.begin = l.begin;
+            s.end = r.end;
+            for (int k = 0; k < 3; ++k) s.count[k] = l.count[k] + r.count[k];
+        }
+    }
+
+    float leaf_cost(std::uint32_t n) const {
+        const SubtreeInfo& s = info_[n];
+        if (!bvh_.nodes[n].is_leaf() && s.end - s.begin > std::uint32_t(config_.max_leaf_prims))
+            return std::numeric_limits<float>::infinity();
+        return config_.block_cost * float(blocks_for<M>(s.count)) * bvh_.nodes[n].box.half_area();
+    }
+
+    // Greedy: a binary subtree becomes a leaf when its blocks cost less than
+    // its nodes and leaves would, counting 1/(N-1) of a wide node per binary
+    // inner node (an N-wide node replaces about N-1 binary ones).
+    void choose_leaves_greedy() {
+        std::vector<float> cost(bvh_.nodes.size());
+        const float per_binary_node = config_.node_cost / float(N - 1);
+        for (std::size_t i = bvh_.nodes.size(); i-- > 0;) {
+            const auto n = std::uint32_t(i);
+            const float leaf = leaf_cost(n);
+            if (bvh_.nodes[n].is_leaf()) {
+                info_[n].leaf = true;
+                cost[n] = leaf;
+                continue;
+            }
+            const float inner = per_binary_node * bvh_.nodes[n].box.half_area() + cost[left(n)] + cost[right(n)];
+            info_[n].leaf = leaf <= inner;
+            cost[n] = std::min(leaf, inner);
+        }
+    }
+
+    // SAH-optimal collapse (Ylitie, Karras, Laine, "Efficient Incoherent Ray
+    // Traversal on GPUs Through Compressed Wide BVHs", HPG 2017, section 4.1):
+    // for each binary node n and slot budget i, the cheapest way to hang n's
+    // subtree below a wide node using at most i child slots, where one slot
+    // holds either a leaf (blocks * block_cost * area) or a wide node
+    // (node_cost * area plus its own N slots).
+    void plan_optimal() {
+        const std::size_t count = bvh_.nodes.size();
+        cost_.assign(count * N, 0.0f);
+        split_.assign(count * N, 0);
+        for (std::size_t i = count; i-- > 0;) {
+            const auto n = std::uint32_t(i);
+            float* c = &cost_[n * N];
+            std::uint8_t* k_best = &split_[n * N];
+            const float leaf = leaf_cost(n);
+            if (bvh_.nodes[n].is_leaf()) {
+                info_[n].leaf = true;
+                std::fill(c, c + N, leaf);
+                continue;
+            }
+            const float* cl = &cost_[left(n) * N];
+            const float* cr = &cost_[right(n) * N];
+            // spread[j]: j slots shared by the two children.
+            std::array<float, N + 1> spread;
+            std::array<std::uint8_t, N + 1> spread_k{};
+            for (int j = 2; j <= N; ++j) {
+                spread[j] = std::numeric_limits<float>::infinity();
+                for (int k = 1; k < j; ++k) {
+                    const float v = cl[k - 1] + cr[j - k - 1];
+                    if (v < spread[j]) spread[j] = v, spread_k[j] = std::uint8_t(k);
+                }
+            }
+            const float inner = config_.node_cost * bvh_.nodes[n].box.half_area() + spread[N];
+            info_[n].leaf = leaf <= inner;
+            c[0] = std::min(leaf, inner);
+            k_best[0] = spread_k[N];  // the split of n's own wide node
+            for (int j = 2; j <= N; ++j) {
+                if (spread[j] < c[j - 2]) {
+                    c[j - 1] = spread[j];
+                    k_best[j - 1] = spread_k[j];
+                } else {
+                    c[j - 1] = c[j - 2];
+                    k_best[j - 1] = 0;
                 }
             }
         }
     }
 
-    std::uint32_t emit_node(std::uint32_t v, int depth) {
-        out_.depth = std::max(out_.depth, depth);
-        // Open the child with the largest surface area until there are N.
-        std::array<std::uint32_t, N> slots;
+    /// Subtree m spread over at most i slots, as the optimal plan says.
+    void gather(std::uint32_t m, int i, std::array<Slot, N>& slots, int& n) const {
+        while (i > 1 && split_[m * N + i - 1] == 0) --i;
+        if (i == 1) {
+            slots[n++] = {m, info_[m].leaf};
+            return;
+        }
+        const int k = split_[m * N + i - 1];
+        gather(left(m), k, slots, n);
+        gather(right(m), i - k, slots, n);
+    }
+
+    /// The child slots of the wide node made from binary node v.
+    int plan_slots(std::uint32_t v, std::array<Slot, N>& slots) const {
         int n = 0;
         if (info_[v].leaf) {
-            slots[n++] = v;  // only at the root: a one-leaf tree
-        } else {
-            slots[n++] = v + 1;
-            slots[n++] = bvh_.nodes[v].first;
+            slots[n++] = {v, true};  // only at the root: a one-leaf tree
+            return n;
         }
+        if (config_.method == CollapseMethod::Optimal) {
+            const int k = split_[v * N];
+            gather(left(v), k, slots, n);
+            gather(right(v), N - k, slots, n);
+            return n;
+        }
+        // Greedy: open the child with the largest surface area until there are N.
+        slots[n++] = {left(v), info_[left(v)].leaf};
+        slots[n++] = {right(v), info_[right(v)].leaf};
         while (n < N) {
             int best = -1;
             float best_area = -1;
             for (int i = 0; i < n; ++i) {
-                if (info_[slots[i]].leaf) continue;
-                const float a = bvh_.nodes[slots[i]].box.half_area();
+                if (slots[i].leaf) continue;
+                const float a = bvh_.nodes[slots[i].node].box.half_area();
                 if (a > best_area) best = i, best_area = a;
             }
             if (best < 0) break;
-            const std::uint32_t u = slots[best];
-            slots[best] = u + 1;
-            slots[n++] = bvh_.nodes[u].first;
+            const std::uint32_t u = slots[best].node;
+            slots[best] = {left(u), info_[left(u)].leaf};
+            slots[n++] = {right(u), info_[right(u)].leaf};
         }
+        return n;
+    }
+
+    std::uint32_t emit_node(std::uint32_t v, int depth) {
+        out_.depth = std::max(out_.depth, depth);
+        std::array<Slot, N> slots;
+        const int n = plan_slots(v, slots);
         const auto index = std::uint32_t(out_.nodes.size());
         WideNode<N>& fresh = out_.nodes.emplace_back();
         for (int i = 0; i < N; ++i) {
@@ -105,10 +211,10 @@ private:
             fresh.child[i] = wide_child::kEmpty;
         }
         for (int i = 0; i < n; ++i) {
-            const std::uint32_t c = slots[i];
-            const std::uint32_t code = info_[c].leaf ? emit_leaf(c) : emit_node(c, depth + 1);
+            const Slot c = slots[i];
+            const std::uint32_t code = c.leaf ? emit_leaf(c.node) : emit_node(c.node, depth + 1);
             WideNode<N>& node = out_.nodes[index];  // emit_node may have grown the vector
-            node.set_box(i, bvh_.nodes[c].box);
+            node.set_box(i, bvh_.nodes[c.node].box);
             node.child[i] = code;
         }
         return index;

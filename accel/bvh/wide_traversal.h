@@ -60,8 +60,13 @@ RAYPACK_INLINE NodeRay<N> make_node_ray(const Rayf& ray) {
         for (int a = 0; a < 3; ++a)
             if (std::fabs(ray.dir[a]) < kMinRcpInput) rd[a] = std::copysign(INFINITY, rd[a]);
     }
+    // Widened by 1 + 2 gamma(3), then one ulp away from zero (the float's
+    // bits + 1, whatever its sign; +-inf stays).
     const float widen = 1.0f + 2.0f * rounding_gamma<float>(3);
-    auto far_of = [&](float r) { return std::nextafter(r * widen, std::copysign(INFINITY, r)); };
+    auto far_of = [&](float r) {
+        const float w = r * widen;
+        return std::isinf(w) ? w : std::bit_cast<float>(std::bit_cast<std::uint32_t>(w) + 1u);
+    };
     NodeRay<N> n;
     n.org = {F(ray.org.x), F(ray.org.y), F(ray.org.z)};
     n.rdir = {F(rd.x), F(rd.y), F(rd.z)};
@@ -124,60 +129,77 @@ RAYPACK_INLINE void record_nearest(std::uint32_t bits, const F& t, const F& u, c
     hit.prim = prim[best];
 }
 
-/// Tests the blocks of one leaf; true if something was hit (any hit: stops
-/// at the first).
-template <TriangleMethod TM, bool AnyHit, int N, int M>
-RAYPACK_INLINE bool intersect_leaf(const WideBvh<N, M>& bvh, SphereMethod sphere_method, std::uint32_t code,
-                                   const LeafRay<vfloat<M>>& r, float& tfar, Hitf& hit) {
+/// Tests a run of blocks of one kind; true if something was hit (any hit:
+/// stops at the first).
+template <TriangleMethod TM, bool AnyHit, int M>
+RAYPACK_INLINE bool intersect_run(const TriangleBlock<M>* b, std::uint32_t count, SphereMethod,
+                                  const LeafRay<vfloat<M>>& r, float& tfar, Hitf& hit) {
     using F = vfloat<M>;
     bool found = false;
-    auto triangles = [&](std::uint32_t first, std::uint32_t count) {
-        for (const TriangleBlock<M>* b = bvh.triangles.data() + first; count != 0; --count, ++b) {
-            F t(0.0f), u(0.0f), v(0.0f);  // set by the kernel on hit lanes only
-            const std::uint32_t bits = mask_bits(intersect_block<TM, F, M>(*b, r, F(tfar), t, u, v));
-            if (bits == 0) continue;
-            found = true;
-            if constexpr (AnyHit) return true;
-            record_nearest(bits, t, u, v, b->prim, tfar, hit);
-        }
-        return false;
-    };
-    auto spheres = [&](std::uint32_t first, std::uint32_t count) {
-        for (const SphereBlock<M>* b = bvh.spheres.data() + first; count != 0; --count, ++b) {
-            F t(0.0f);
-            const std::uint32_t bits = mask_bits(intersect_block<F, M>(*b, sphere_method, r, F(tfar), t));
-            if (bits == 0) continue;
-            found = true;
-            if constexpr (AnyHit) return true;
-            record_nearest(bits, t, F(0.0f), F(0.0f), b->prim, tfar, hit);
-        }
-        return false;
-    };
-    auto cones = [&](std::uint32_t first, std::uint32_t count) {
-        for (const ConeBlock<M>* b = bvh.cones.data() + first; count != 0; --count, ++b) {
-            F t(0.0f), s(0.0f);
-            const std::uint32_t bits = mask_bits(intersect_block<F, M>(*b, r, F(tfar), t, s));
-            if (bits == 0) continue;
-            found = true;
-            if constexpr (AnyHit) return true;
-            record_nearest(bits, t, s, F(0.0f), b->prim, tfar, hit);
-        }
-        return false;
-    };
+    for (; count != 0; --count, ++b) {
+        F t(0.0f), u(0.0f), v(0.0f);  // set by the kernel on hit lanes only
+        const std::uint32_t bits = mask_bits(intersect_block<TM, F, M>(*b, r, F(tfar), t, u, v));
+        if (bits == 0) continue;
+        if constexpr (AnyHit) return true;
+        found = true;
+        record_nearest(bits, t, u, v, b->prim, tfar, hit);
+    }
+    return found;
+}
+
+template <TriangleMethod TM, bool AnyHit, int M>
+RAYPACK_INLINE bool intersect_run(const SphereBlock<M>* b, std::uint32_t count, SphereMethod method,
+                                  const LeafRay<vfloat<M>>& r, float& tfar, Hitf& hit) {
+    using F = vfloat<M>;
+    bool found = false;
+    for (; count != 0; --count, ++b) {
+        F t(0.0f);
+        const std::uint32_t bits = mask_bits(intersect_block<F, M>(*b, method, r, F(tfar), t));
+        if (bits == 0) continue;
+        if constexpr (AnyHit) return true;
+        found = true;
+        record_nearest(bits, t, F(0.0f), F(0.0f), b->prim, tfar, hit);
+    }
+    return found;
+}
+
+template <TriangleMethod TM, bool AnyHit, int M>
+RAYPACK_INLINE bool intersect_run(const ConeBlock<M>* b, std::uint32_t count, SphereMethod,
+                                  const LeafRay<vfloat<M>>& r, float& tfar, Hitf& hit) {
+    using F = vfloat<M>;
+    bool found = false;
+    for (; count != 0; --count, ++b) {
+        F t(0.0f), s(0.0f);
+        const std::uint32_t bits = mask_bits(intersect_block<F, M>(*b, r, F(tfar), t, s));
+        if (bits == 0) continue;
+        if constexpr (AnyHit) return true;
+        found = true;
+        record_nearest(bits, t, s, F(0.0f), b->prim, tfar, hit);
+    }
+    return found;
+}
+
+/// Tests the blocks of one leaf; true if something was hit.
+template <TriangleMethod TM, bool AnyHit, int N, int M>
+RAYPACK_INLINE bool intersect_leaf(const WideBvh<N, M>& bvh, SphereMethod sm, std::uint32_t code,
+                                   const LeafRay<vfloat<M>>& r, float& tfar, Hitf& hit) {
     const std::uint32_t first = wide_child::first(code), count = wide_child::blocks(code);
     switch (wide_child::kind(code)) {
-        case LeafKind::Triangle: triangles(first, count); break;
-        case LeafKind::Sphere: spheres(first, count); break;
-        case LeafKind::Cone: cones(first, count); break;
-        case LeafKind::Mixed: {
-            const MixedLeaf& m = bvh.mixed[first];
-            constexpr int tri = int(LeafKind::Triangle), sph = int(LeafKind::Sphere), cone = int(LeafKind::Cone);
-            if (triangles(m.first[tri], m.count[tri])) return true;
-            if (spheres(m.first[sph], m.count[sph])) return true;
-            cones(m.first[cone], m.count[cone]);
-            break;
-        }
+        case LeafKind::Triangle:
+            return intersect_run<TM, AnyHit>(bvh.triangles.data() + first, count, sm, r, tfar, hit);
+        case LeafKind::Sphere:
+            return intersect_run<TM, AnyHit>(bvh.spheres.data() + first, count, sm, r, tfar, hit);
+        case LeafKind::Cone:
+            return intersect_run<TM, AnyHit>(bvh.cones.data() + first, count, sm, r, tfar, hit);
+        case LeafKind::Mixed: break;
     }
+    const MixedLeaf& m = bvh.mixed[first];
+    constexpr int tri = int(LeafKind::Triangle), sph = int(LeafKind::Sphere), cone = int(LeafKind::Cone);
+    bool found = intersect_run<TM, AnyHit>(bvh.triangles.data() + m.first[tri], m.count[tri], sm, r, tfar, hit);
+    if (AnyHit && found) return true;
+    found |= intersect_run<TM, AnyHit>(bvh.spheres.data() + m.first[sph], m.count[sph], sm, r, tfar, hit);
+    if (AnyHit && found) return true;
+    found |= intersect_run<TM, AnyHit>(bvh.cones.data() + m.first[cone], m.count[cone], sm, r, tfar, hit);
     return found;
 }
 
