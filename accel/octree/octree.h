@@ -20,6 +20,9 @@ struct OctreeConfig {
     int leaf_size = 8;
     /// ... and is shallower than this (the root is depth 0; at most kOctreeMaxDepth).
     int max_depth = 12;
+    /// A split is not made if this many of the children would hold every
+    /// reference of the node: it would only duplicate them (see octree_build.cpp).
+    int full_children_stop = 2;
     /// Place triangles by exact triangle-box overlap and spheres by their
     /// distance to the box; false places every primitive by its box only.
     bool exact_overlap = true;

@@ -69,7 +69,7 @@ public:
         // single full child still cuts away empty space, so it continues.
         int full = 0;
         for (const auto& r : child_refs) full += r.size() == n;
-        if (full >= 2) return;
+        if (full >= std::max(1, config_.full_children_stop)) return;
         node.refs.clear();
         node.refs.shrink_to_fit();
         node.kids = std::make_unique<std::array<BuildNode, 8>>();
