@@ -40,17 +40,21 @@ void walk(const Octree& tree, const PacketPrimitiveIntersector<vfloat<K>>& isect
     using M = vmask<K>;
     const OctreeNode* nodes = tree.nodes.data();
     const std::uint32_t* refs = tree.refs.data();
-    PacketFrame<K> f;
+    // Frames live in the stack array and are never copied: the current node
+    // is the top one (9 vectors each, 576 bytes at K = 16).
+    PacketFrame<K> stack[kOctreeMaxDepth + 1];
+    int sp = 0;
+    PacketFrame<K>* f = &stack[0];
     const Vec3<F> lo = splat<F>(tree.cube.lo), hi = splat<F>(tree.cube.hi);
     for (int k = 0; k < 3; ++k) {
         const F tlo = (lo[k] - ray.org[k]) * ray.rdir[k], thi = (hi[k] - ray.org[k]) * ray.rdir[k];
         const bool mirrored = a & (4u >> k);
-        f.t0[k] = mirrored ? thi : tlo;
-        f.t1[k] = mirrored ? tlo : thi;
-        f.tm[k] = F(0.5f) * (f.t0[k] + f.t1[k]);
+        f->t0[k] = mirrored ? thi : tlo;
+        f->t1[k] = mirrored ? tlo : thi;
+        f->tm[k] = F(0.5f) * (f->t0[k] + f->t1[k]);
     }
-    M active = group & (vmax(max3(f.t0[0], f.t0[1], f.t0[2]), ray.tnear) <=
-                        vmin(min3(f.t1[0], f.t1[1], f.t1[2]), ray.tfar));
+    M active = group & (vmax(max3(f->t0[0], f->t0[1], f->t0[2]), ray.tnear) <=
+                        vmin(min3(f->t1[0], f->t1[1], f->t1[2]), ray.tfar));
     if (none(active)) return;
     M done = active & !active;  // lanes with an occluder (any hit)
     auto test_leaf = [&](const OctreeNode& leaf, M m) {
@@ -68,28 +72,26 @@ void walk(const Octree& tree, const PacketPrimitiveIntersector<vfloat<K>>& isect
         test_leaf(nodes[0], active);
         return;
     }
-    f.active = active;
-    f.children = nodes[0].first;
-    f.child = 0;
-    PacketFrame<K> stack[kOctreeMaxDepth];
-    int sp = 0;
+    f->active = active;
+    f->children = nodes[0].first;
+    f->child = 0;
     for (;;) {
-        if (f.child >= 8) {
+        if (f->child >= 8) {
             if (sp == 0) return;
-            f = stack[--sp];
+            f = &stack[--sp];
             continue;
         }
-        const int c = f.child++;
-        const OctreeNode node = nodes[f.children + (unsigned(c) ^ a)];
+        const int c = f->child++;
+        const OctreeNode node = nodes[f->children + (unsigned(c) ^ a)];
         if (node.count == 0) continue;  // an empty leaf
         const F* c0[3];
         const F* c1[3];
         for (int k = 0; k < 3; ++k) {
             const bool upper = c & (4 >> k);
-            c0[k] = upper ? &f.tm[k] : &f.t0[k];
-            c1[k] = upper ? &f.t1[k] : &f.tm[k];
+            c0[k] = upper ? &f->tm[k] : &f->t0[k];
+            c1[k] = upper ? &f->t1[k] : &f->tm[k];
         }
-        M m = f.active & (vmax(max3(*c0[0], *c0[1], *c0[2]), ray.tnear) <= vmin(min3(*c1[0], *c1[1], *c1[2]), ray.tfar));
+        M m = f->active & (vmax(max3(*c0[0], *c0[1], *c0[2]), ray.tnear) <= vmin(min3(*c1[0], *c1[1], *c1[2]), ray.tfar));
         if constexpr (AnyHit) m = m & !done;
         if (none(m)) continue;
         if (node.is_leaf()) {
@@ -98,16 +100,17 @@ void walk(const Octree& tree, const PacketPrimitiveIntersector<vfloat<K>>& isect
                 if (all(done | !group)) return;
             continue;
         }
-        stack[sp++] = f;
+        PacketFrame<K>* g = &stack[++sp];
         for (int k = 0; k < 3; ++k) {
             const F t0 = *c0[k], t1 = *c1[k];
-            f.t0[k] = t0;
-            f.t1[k] = t1;
-            f.tm[k] = F(0.5f) * (t0 + t1);
+            g->t0[k] = t0;
+            g->t1[k] = t1;
+            g->tm[k] = F(0.5f) * (t0 + t1);
         }
-        f.active = m;
-        f.children = node.first;
-        f.child = 0;
+        g->active = m;
+        g->children = node.first;
+        g->child = 0;
+        f = g;
     }
 }
 
