@@ -10,11 +10,13 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <filesystem>
 #include <functional>
 #include <iomanip>
 #include <limits>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <string>
@@ -23,8 +25,10 @@
 #include "accel/accel.h"
 #include "accel/brute/brute_force.h"
 #include "accel/grid/dda.h"
+#include "accel/grid/dda_packet.h"
 #include "accel/grid/grid_accel.h"
 #include "accel/grid/grid_build.h"
+#include "accel/grid/grid_packet.h"
 #include "accel/grid/triangle_box_overlap.h"
 #include "render/camera_rays.h"
 #include "scene/load.h"
@@ -852,6 +856,128 @@ TEST_F(Grid, TrianglesAreInExactlyTheCellsTheyMeet) {
     GridConfig boxes_only;
     boxes_only.exact_overlap = false;
     EXPECT_LT(grid->reference_count(), make_grid(scene, boxes_only)->reference_count());
+}
+
+// ---- Packets: every lane stepping its own DDA ------------------------------------------------
+
+/// The packet DDA of width K against K single-ray DDAs, in lockstep.
+template <int K>
+void expect_packet_walks_equal(const GridGeometry& g, const std::vector<Rayf>& rays) {
+    using F = vfloat<K>;
+    for (std::size_t first = 0; first + K <= rays.size(); first += K) {
+        vmask<K> valid;
+        const RayPacket<K> packet = load_packet<K>(std::span<const Rayf>(rays).subspan(first, K), valid);
+        alignas(64) float start[K];
+        std::vector<GridDda> single;
+        std::uint32_t walking = 0;
+        for (int l = 0; l < K; ++l) {
+            const Rayf& r = rays[first + l];
+            float entry = 0;
+            if (intersect_aabb(r.org, reciprocal(r.dir), g.bounds, r.tnear, r.tfar, entry)) walking |= 1u << l;
+            start[l] = entry;
+            single.emplace_back(g, r.org, r.dir, reciprocal(r.dir), entry);
+        }
+        GridDdaPacket<K> dda(g, packet, load_lanes<F>(start));
+        alignas(64) std::int32_t cells[K];
+        alignas(64) float t_exit[K];
+        for (int round = 0; walking && round < 1000; ++round) {
+            dda.cells(cells);
+            const auto x = dda.crossing();
+            store_lanes(t_exit, x.t);
+            std::uint32_t out = 0;
+            for (std::uint32_t bits = walking; bits; bits &= bits - 1) {
+                const int l = std::countr_zero(bits);
+                const std::optional<DdaSegment> seg = single[l].next();
+                ASSERT_TRUE(seg.has_value());
+                ASSERT_EQ(std::uint32_t(cells[l]), seg->cell) << describe(rays[first + l]) << " round " << round;
+                ASSERT_EQ(std::bit_cast<std::uint32_t>(t_exit[l]), std::bit_cast<std::uint32_t>(seg->t_exit))
+                    << describe(rays[first + l]) << " round " << round;
+            }
+            alignas(64) float lanes_on[K];
+            for (int l = 0; l < K; ++l) lanes_on[l] = (walking >> l) & 1u ? 1.0f : 0.0f;
+            const vmask<K> on = load_lanes<F>(lanes_on) > F(0.0f);
+            out = mask_bits(dda.advance(x, on));
+            for (std::uint32_t bits = out; bits; bits &= bits - 1)
+                EXPECT_FALSE(single[std::countr_zero(bits)].next().has_value());
+            walking &= ~out;
+        }
+        EXPECT_EQ(walking, 0u);
+    }
+}
+
+TEST_F(Grid, PacketDdaWalksLikeSingleRays) {
+    std::mt19937 rng(31);
+    for (const char* file : {"teapot.nff", "balls.nff"}) {
+        const Scene scene = load_scene(std::string(RAYPACK_SOURCE_DIR) + "/scenes/" + file);
+        const auto grid = make_grid(scene);
+        const GridGeometry& g = grid->grid().geometry;
+        std::vector<Rayf> rays = grid_adversarial_rays(g, scene, rng);
+        const std::vector<Rayf> random = random_rays(scene, rng, 1000);
+        rays.insert(rays.end(), random.begin(), random.end());
+        if constexpr (kWidthCompiled<4>) expect_packet_walks_equal<4>(g, rays);
+        if constexpr (kWidthCompiled<8>) expect_packet_walks_equal<8>(g, rays);
+        if constexpr (kWidthCompiled<16>) expect_packet_walks_equal<16>(g, rays);
+    }
+}
+
+TEST_F(Grid, PacketsEqualSingleRays) {
+    // Packets have no mailbox, so they must equal the single-ray walk without
+    // one bit for bit: the same cells in the same order per lane, the same
+    // kernels. Against the default walk (with mailbox) only ties may differ.
+    const KernelChoice variants[] = {
+        {SphereMethod::Geometric, TriangleMethod::Moeller},
+        {SphereMethod::Algebraic, TriangleMethod::Watertight},
+        {SphereMethod::Precise, TriangleMethod::Plane},
+    };
+    std::mt19937 rng(29);
+    for (const char* file : {"balls.nff", "mount.nff", "rings.nff", "teapot.nff", "tetra.nff", "tree.nff"}) {
+        const Scene scene = load_scene(std::string(RAYPACK_SOURCE_DIR) + "/scenes/" + file);
+        for (const KernelChoice& kc : variants) {
+            AccelConfig config;
+            config.kernels = kc;
+            GridConfig no_mailbox;
+            no_mailbox.mailbox = false;
+            const GridAccel grid(scene, config, no_mailbox);
+            std::vector<Rayf> rays = camera_rays(scene, 40);
+            const std::vector<Rayf> random = random_rays(scene, rng, 800);
+            const std::vector<Rayf> adv = grid_adversarial_rays(grid.grid().geometry, scene, rng);
+            rays.insert(rays.end(), random.begin(), random.end());
+            rays.insert(rays.end(), adv.begin(), adv.end());
+            rays.resize(rays.size() - 3);  // a ragged last packet
+            std::vector<Hitf> want(rays.size());
+            grid.intersect(rays, want);
+            const std::vector<Rayf> shadows = shadow_rays(scene, rays, want);
+            std::vector<std::uint8_t> want_occ(shadows.size());
+            grid.occluded(shadows, want_occ);
+            const GridAccel with_mailbox(scene, config);
+            for (int width : {4, 8, 16}) {
+                if (!grid.supports_packet(width)) continue;
+                SCOPED_TRACE(::testing::Message() << file << " width " << width << " sphere " << int(kc.sphere)
+                                                  << " triangle " << int(kc.triangle));
+                std::vector<Hitf> got(rays.size());
+                grid.intersect_packets(width, rays, got);
+                int differ = 0;
+                for (std::size_t i = 0; i < rays.size(); ++i) {
+                    const bool same = got[i].prim == want[i].prim &&
+                                      std::bit_cast<std::uint32_t>(got[i].t) == std::bit_cast<std::uint32_t>(want[i].t) &&
+                                      std::bit_cast<std::uint32_t>(got[i].u) == std::bit_cast<std::uint32_t>(want[i].u) &&
+                                      std::bit_cast<std::uint32_t>(got[i].v) == std::bit_cast<std::uint32_t>(want[i].v);
+                    if (!same && ++differ <= 3)
+                        ADD_FAILURE() << describe(rays[i]) << "\n  single " << describe(want[i]) << ", packet "
+                                      << describe(got[i]);
+                }
+                EXPECT_EQ(differ, 0);
+                std::vector<std::uint8_t> occ(shadows.size());
+                grid.occluded_packets(width, shadows, occ);
+                EXPECT_EQ(occ, want_occ);
+                std::vector<Hitf> mailboxed(rays.size());
+                with_mailbox.intersect(rays, mailboxed);
+                std::size_t n = 0;
+                const std::string first = hit_mismatches(rays, mailboxed, got, n);
+                EXPECT_EQ(n, 0u) << first;
+            }
+        }
+    }
 }
 
 }  // namespace

@@ -4,10 +4,13 @@
 
 #include <algorithm>
 #include <chrono>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "accel/grid/dda.h"
 #include "accel/grid/grid_build.h"
+#include "accel/grid/grid_packet.h"
 
 namespace raypack {
 
@@ -124,6 +127,39 @@ bool GridAccel::occluded_counting(const Rayf& ray_in, GridRayCounters& counters)
     Rayf ray = ray_in;
     Hitf hit;
     return trace<true, true>(ray, hit, &counters);
+}
+
+bool GridAccel::supports_packet(int width) const {
+    return width == 1 || (width == 4 && kWidthCompiled<4>) || (width == 8 && kWidthCompiled<8>) ||
+           (width == 16 && kWidthCompiled<16>);
+}
+
+template <bool AnyHit>
+void GridAccel::trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
+    switch (width) {
+#if defined(__SSE4_2__)
+        case 4: return grid_trace_packets<4, AnyHit>(grid_, *scene_, kernels_, rays, hits);
+#endif
+#if defined(__AVX2__)
+        case 8: return grid_trace_packets<8, AnyHit>(grid_, *scene_, kernels_, rays, hits);
+#endif
+#if defined(__AVX512BW__)
+        case 16: return grid_trace_packets<16, AnyHit>(grid_, *scene_, kernels_, rays, hits);
+#endif
+        default: throw std::invalid_argument("grid: packet width " + std::to_string(width) + " is not compiled in");
+    }
+}
+
+void GridAccel::intersect_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
+    if (width == 1 || !grid_packets_exact(grid_)) return intersect(rays, hits);
+    trace_packets<false>(width, rays, hits);
+}
+
+void GridAccel::occluded_packets(int width, std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const {
+    if (width == 1 || !grid_packets_exact(grid_)) return this->occluded(rays, occluded);
+    std::vector<Hitf> hits(rays.size());
+    trace_packets<true>(width, rays, hits);
+    for (std::size_t i = 0; i < rays.size(); ++i) occluded[i] = hits[i].found() ? 1 : 0;
 }
 
 }  // namespace raypack

@@ -23,6 +23,13 @@ public:
     void occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override;
     const AccelStats& stats() const override { return stats_; }
 
+    /// K-wide traversal, each lane stepping its own DDA (grid_packet.h). It
+    /// has no mailbox: its answers equal those of the single-ray walk with
+    /// GridConfig::mailbox off, bit for bit.
+    bool supports_packet(int width) const override;
+    void intersect_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const override;
+    void occluded_packets(int width, std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override;
+
     /// The same queries, adding each ray's work to `counters` (slower; tests and analysis).
     Hitf intersect_counting(const Rayf& ray, GridRayCounters& counters) const;
     bool occluded_counting(const Rayf& ray, GridRayCounters& counters) const;
@@ -40,6 +47,8 @@ public:
     std::size_t empty_cells() const { return empty_cells_; }
 
 private:
+    template <bool AnyHit>
+    void trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const;
     template <bool AnyHit, bool Counting, bool Mailbox>
     bool trace(Rayf& ray, Hitf& hit, GridRayCounters* counters) const;
     template <bool AnyHit, bool Counting>

@@ -1,0 +1,146 @@
+#include "accel/grid/grid_packet.h"
+
+#include <bit>
+#include <limits>
+
+#include "accel/grid/dda_packet.h"
+#include "accel/packet_intersector.h"
+#include "kernels/aabb.h"
+#include "kernels/ray_packet.h"
+
+namespace raypack {
+namespace {
+
+/// Lane mask from bits, lane i from bit i.
+template <int K>
+RAYPACK_INLINE vmask<K> mask_from_bits(std::uint32_t bits) {
+#if defined(__AVX512F__)
+    if constexpr (K == 16) return vmask<K>(__mmask16(bits));
+#endif
+#if defined(__AVX2__)
+    if constexpr (K == 8) {
+        const __m256i lane_bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+        const __m256i b = _mm256_and_si256(_mm256_set1_epi32(int(bits)), lane_bit);
+        return vmask<K>(_mm256_castsi256_ps(_mm256_cmpeq_epi32(b, lane_bit)));
+    }
+#endif
+    if constexpr (K == 4) {
+        const __m128i lane_bit = _mm_setr_epi32(1, 2, 4, 8);
+        const __m128i b = _mm_and_si128(_mm_set1_epi32(int(bits)), lane_bit);
+        return vmask<K>(_mm_castsi128_ps(_mm_cmpeq_epi32(b, lane_bit)));
+    }
+}
+
+// Each round: lanes standing in empty cells just step; of the lanes in
+// cells with references, the first one's cell is tested for every lane that
+// stands in it, and those lanes step too. A lane stops where its single-ray
+// walk stops: when its current cell ends past its tfar, or at the grid's
+// boundary (or, for occlusion, at its first hit).
+template <int K, bool AnyHit>
+void trace_packet(const Grid& grid, const PacketPrimitiveIntersector<vfloat<K>>& isect, RayPacket<K>& ray,
+                  HitPacket<K>& hit, vmask<K> valid, vmask<K>& occluded) {
+    using F = vfloat<K>;
+    using M = vmask<K>;
+    const GridGeometry& g = grid.geometry;
+    const SlabRay<F> slab{ray.org, ray.rdir, {}, ray.tnear, ray.tfar};  // robust: org_rdir unused
+    F entry;
+    M active = intersect_box<SlabMethod::Robust, F>(valid, slab, splat<F>(g.bounds.lo), splat<F>(g.bounds.hi), entry);
+    if (none(active)) return;
+    GridDdaPacket<K> dda(g, ray, entry);
+    const std::uint32_t* begin = grid.cell_begin.data();
+    const std::uint32_t* refs = grid.refs.data();
+    alignas(64) std::int32_t cell[K];
+    for (;;) {
+        dda.cells(cell);
+        std::uint32_t walking = mask_bits(active), full = 0;
+        for (std::uint32_t bits = walking; bits; bits &= bits - 1) {
+            const int l = std::countr_zero(bits);
+            if (begin[cell[l]] != begin[cell[l] + 1]) full |= 1u << l;
+        }
+        if (full) {
+            const std::int32_t c = cell[std::countr_zero(full)];
+            std::uint32_t here = 0;
+            for (std::uint32_t bits = full; bits; bits &= bits - 1) {
+                const int l = std::countr_zero(bits);
+                if (cell[l] == c) here |= 1u << l;
+            }
+            walking &= ~(full & ~here);  // lanes in other full cells wait for a later round
+            M testing = mask_from_bits<K>(here);
+            for (std::uint32_t k = begin[c]; k < begin[c + 1]; ++k) {
+                const M m = isect.intersect(testing, ray, hit, refs[k]);
+                if constexpr (AnyHit) {
+                    occluded = occluded | m;
+                    testing = testing & !m;
+                    active = active & !m;
+                    if (none(testing)) break;
+                }
+            }
+        }
+        const M step = active & mask_from_bits<K>(walking);
+        const typename GridDdaPacket<K>::Crossing x = dda.crossing();
+        const M beyond = step & (x.t > ray.tfar);
+        active = active & !beyond;
+        active = active & !dda.advance(x, step & !beyond);
+        if (none(active)) return;
+    }
+}
+
+}  // namespace
+
+bool grid_packets_exact(const Grid& grid) {
+    for (int r : grid.geometry.res)
+        if (r >= (1 << 24)) return false;
+    return true;
+}
+
+template <int K, bool AnyHit>
+void grid_trace_packets(const Grid& grid, const Scene& scene, KernelChoice kernels, std::span<const Rayf> rays,
+                        std::span<Hitf> hits) {
+    using F = vfloat<K>;
+    const PacketPrimitiveIntersector<F> isect{&scene, kernels};
+    for (std::size_t first = 0; first < rays.size(); first += K) {
+        const std::size_t n = std::min<std::size_t>(K, rays.size() - first);
+        vmask<K> valid;
+        RayPacket<K> ray = load_packet<K>(rays.subspan(first, n), valid);
+        HitPacket<K> hit;
+        hit.t = F(std::numeric_limits<float>::infinity());
+        hit.u = hit.v = F(0.0f);
+        for (auto& p : hit.prim) p = kNoPrim;
+        vmask<K> occluded = valid & !valid;
+        if (!grid.empty()) trace_packet<K, AnyHit>(grid, isect, ray, hit, valid, occluded);
+        alignas(64) float t[K], u[K], v[K];
+        store_lanes(t, hit.t);
+        store_lanes(u, hit.u);
+        store_lanes(v, hit.v);
+        const std::uint32_t occ = mask_bits(occluded);
+        for (std::size_t i = 0; i < n; ++i) {
+            if constexpr (AnyHit) {
+                hits[first + i] = Hitf{};
+                if ((occ >> i) & 1u) hits[first + i].prim = 0;
+            } else {
+                hits[first + i] = Hitf{t[i], hit.prim[i], u[i], v[i]};
+            }
+        }
+    }
+}
+
+#if defined(__SSE4_2__)
+template void grid_trace_packets<4, false>(const Grid&, const Scene&, KernelChoice, std::span<const Rayf>,
+                                              std::span<Hitf>);
+template void grid_trace_packets<4, true>(const Grid&, const Scene&, KernelChoice, std::span<const Rayf>,
+                                              std::span<Hitf>);
+#endif
+#if defined(__AVX2__)
+template void grid_trace_packets<8, false>(const Grid&, const Scene&, KernelChoice, std::span<const Rayf>,
+                                              std::span<Hitf>);
+template void grid_trace_packets<8, true>(const Grid&, const Scene&, KernelChoice, std::span<const Rayf>,
+                                              std::span<Hitf>);
+#endif
+#if defined(__AVX512BW__)
+template void grid_trace_packets<16, false>(const Grid&, const Scene&, KernelChoice, std::span<const Rayf>,
+                                              std::span<Hitf>);
+template void grid_trace_packets<16, true>(const Grid&, const Scene&, KernelChoice, std::span<const Rayf>,
+                                              std::span<Hitf>);
+#endif
+
+}  // namespace raypack
