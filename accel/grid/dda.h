@@ -4,8 +4,8 @@
 // pbrt-v4's DDAMajorantIterator: next() yields the cells a ray crosses, front
 // to back, each with the parametric interval it spends there.
 //
-// One iterator is the whole per-ray state, so a K-wide traversal can give
-// each lane its own and step them independently.
+// One iterator is the whole per-ray state; dda_packet.h runs the same walk
+// in K lanes, each stepping independently.
 //
 // Robustness choices:
 // - The crossing distance of the k-th plane is t_first + k * tDelta with one

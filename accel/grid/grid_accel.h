@@ -1,5 +1,6 @@
 #pragma once
-// Uniform grid traversed by a 3D-DDA, single ray.
+// Uniform grid traversed by a 3D-DDA: single rays (dda.h) and K-wide
+// packets with every lane stepping its own walk (dda_packet.h).
 #include <array>
 #include <cstdint>
 
