@@ -538,6 +538,94 @@ TEST_F(WideBvh, OtherKernelsMatchBruteForce) {
     }
 }
 
+// ---- The node test alone ------------------------------------------------------------------
+
+/// Entry and exit of the float ray through a box in long double: the
+/// reference the node test must never be less generous than.
+bool box_hit_reference(const Rayf& r, const Box3f& b) {
+    if (b.empty()) return false;
+    long double t0 = r.tnear, t1 = r.tfar;
+    for (int a = 0; a < 3; ++a) {
+        const long double o = r.org[a], d = r.dir[a], lo = b.lo[a], hi = b.hi[a];
+        if (d == 0) {
+            if (o < lo || o > hi) return false;
+            continue;
+        }
+        long double n = (lo - o) / d, f = (hi - o) / d;
+        if (n > f) std::swap(n, f);
+        t0 = std::max(t0, n);
+        t1 = std::min(t1, f);
+    }
+    return t0 <= t1;
+}
+
+template <int N>
+void check_node_test(int rays_per_node) {
+    std::mt19937 rng(99);
+    std::uniform_real_distribution<float> u(-1, 1);
+    std::uniform_int_distribution<int> e(-6, 6);
+    std::size_t reference_hits = 0, missed = 0, extra = 0;
+    std::string first;
+    for (int trial = 0; trial < 400; ++trial) {
+        // Boxes at scales 2^-6 .. 2^6, away from the origin by up to 2^7.
+        const float scale = std::ldexp(1.0f, e(rng)), offset = std::ldexp(1.0f, e(rng) + 1);
+        WideNode<N> node;
+        std::vector<Box3f> boxes(N);
+        for (int i = 0; i < N; ++i) {
+            Box3f b;
+            const Vec3f c{u(rng) * offset, u(rng) * offset, u(rng) * offset};
+            b.extend(c);
+            b.extend(c + Vec3f{u(rng), u(rng), u(rng)} * scale);
+            if (i == N - 1 && trial % 2) b = Box3f{};  // an unused slot
+            boxes[i] = b;
+            node.set_box(i, b);
+            node.child[i] = 0;
+        }
+        for (int k = 0; k < rays_per_node; ++k) {
+            // Aim at a corner, an edge point or a face point of one box.
+            const Box3f& b = boxes[rng() % (N - 1)];
+            Vec3f target;
+            for (int a = 0; a < 3; ++a) {
+                const float t = (rng() % 3 == 0) ? 0.5f * (u(rng) + 1) : float(rng() % 2);
+                target[a] = b.lo[a] + t * (b.hi[a] - b.lo[a]);
+                if (t == 1.0f) target[a] = b.hi[a];
+            }
+            Rayf r;
+            r.org = Vec3f{u(rng), u(rng), u(rng)} * (offset * 4);
+            r.dir = target - r.org;
+            if (k % 7 == 0) r.dir[rng() % 3] = 0.0f;  // parallel to one slab
+            if (k % 11 == 0) r.org = target - r.dir;   // ends exactly ...
+            if (!(dot(r.dir, r.dir) > 0)) continue;
+            const NodeRay<N> nr = make_node_ray<NodeTest::Ordered, N>(r);
+            vfloat<N> entry;
+            const std::uint32_t bits = node_hits<NodeTest::Ordered>(node, nr, vfloat<N>(r.tfar), entry);
+            for (int i = 0; i < N; ++i) {
+                const bool want = box_hit_reference(r, boxes[i]), got = (bits >> i) & 1u;
+                reference_hits += want;
+                if (got && !want) {
+                    // Only a graze: the box grown by a relative 1e-5 is met.
+                    Box3f grown = boxes[i];
+                    const float delta = 1e-5f * (length(r.org) + length(grown.lo) + length(grown.hi));
+                    grown.extend(grown.lo - Vec3f{delta, delta, delta});
+                    grown.extend(grown.hi + Vec3f{delta, delta, delta});
+                    extra += !box_hit_reference(r, grown);
+                }
+                if (want && !got && ++missed <= 3) first += "\n  " + describe(r) + " box " + std::to_string(i);
+            }
+        }
+    }
+    EXPECT_EQ(missed, 0u) << "boxes the exact ray meets were culled" << first;
+    EXPECT_GT(reference_hits, 1000u);
+    EXPECT_EQ(extra, 0u) << "boxes the ray misses by far were entered";
+}
+
+TEST_F(WideBvh, NodeTestNeverCullsABoxTheExactRayMeets) {
+    check_node_test<4>(400);
+#if defined(__AVX2__)
+    check_node_test<8>(400);
+#endif
+}
+
 // ---- Hand-made cases -------------------------------------------------------------------
 
 Scene one_sphere() {

@@ -9,30 +9,9 @@
 #include <cstdint>
 
 #include "accel/bvh/wide_bvh.h"
+#include "accel/bvh/wide_node_test.h"
 
 namespace raypack {
-
-/// How a node's N boxes are tested.
-/// - Ordered: Ize's robust form (lo - org) * rdir, but with the near and far
-///   plane of each axis chosen once per ray from the sign of the reciprocal
-///   direction (Williams et al., "An Efficient and Robust Ray-Box
-///   Intersection Algorithm", JGT 2005; Embree's nearX/farX), so there is no
-///   per-axis min/max, and the far distances use a reciprocal widened by
-///   1 + 2 gamma(3) and one ulp (for the rounding of that product): Ize's
-///   widening folded into the ray, as bvh v2 pads rdir. A direction
-///   component that reciprocal() would clamp (a ray parallel to the slab)
-///   gets the reciprocal +-inf instead: inside the slab the distances are
-///   -inf / +inf, outside +inf / -inf (a miss), and on a plane 0 * inf =
-///   NaN. x86 min and max return their second operand when one is NaN, and
-///   the chain ends with tnear / tfar (never NaN) second, so a NaN never
-///   reaches the result: it is dropped, at worst with the other distance of
-///   its pair, which only widens [entry, exit]. So, as in Robust, a ray
-///   parallel to a slab and inside [lo, hi], boundaries included, is never
-///   culled by it. The empty box (lo = +inf, hi = -inf) always gives
-///   near = +inf or far = -inf.
-/// - Plain, Robust: kernels/aabb.h intersect_box, for comparison (empty
-///   slots then need a mask, lo_x <= hi_x).
-enum class NodeTest { Ordered, Plain, Robust };
 
 /// Stack entries: a child and its entry distance, so that a pop can skip
 /// nodes entered beyond the closest hit found since the push.
@@ -40,76 +19,6 @@ struct WideStackEntry {
     std::uint32_t node;
     float dist;
 };
-
-/// The ray as the node test sees it, broadcast to N lanes once per ray.
-template <int N>
-struct NodeRay {
-    using F = vfloat<N>;
-    Vec3<F> org, rdir, rdir_far;
-    Vec3<F> org_rdir;  ///< for NodeTest::Plain only
-    F tnear;
-    int near_x, near_y, near_z;  ///< rows of WideNode::bounds with the near planes ...
-    int far_x, far_y, far_z;     ///< ... and with the far planes
-};
-
-template <NodeTest Test, int N>
-RAYPACK_INLINE NodeRay<N> make_node_ray(const Rayf& ray) {
-    using F = vfloat<N>;
-    Vec3f rd = reciprocal(ray.dir);
-    if constexpr (Test == NodeTest::Ordered) {
-        for (int a = 0; a < 3; ++a)
-            if (std::fabs(ray.dir[a]) < kMinRcpInput) rd[a] = std::copysign(INFINITY, rd[a]);
-    }
-    // Widened by 1 + 2 gamma(3), then one ulp away from zero (the float's
-    // bits + 1, whatever its sign; +-inf stays).
-    const float widen = 1.0f + 2.0f * rounding_gamma<float>(3);
-    auto far_of = [&](float r) {
-        const float w = r * widen;
-        return std::isinf(w) ? w : std::bit_cast<float>(std::bit_cast<std::uint32_t>(w) + 1u);
-    };
-    NodeRay<N> n;
-    n.org = {F(ray.org.x), F(ray.org.y), F(ray.org.z)};
-    n.rdir = {F(rd.x), F(rd.y), F(rd.z)};
-    n.rdir_far = {F(far_of(rd.x)), F(far_of(rd.y)), F(far_of(rd.z))};
-    n.org_rdir = {F(ray.org.x * rd.x), F(ray.org.y * rd.y), F(ray.org.z * rd.z)};
-    n.tnear = F(ray.tnear);
-    n.near_x = rd.x >= 0 ? 0 : 3;
-    n.near_y = rd.y >= 0 ? 1 : 4;
-    n.near_z = rd.z >= 0 ? 2 : 5;
-    n.far_x = 3 - n.near_x;
-    n.far_y = 5 - n.near_y;
-    n.far_z = 7 - n.near_z;
-    return n;
-}
-
-/// Bit i set when the ray meets child box i within [tnear, tfar]; `entry`
-/// gets the entry distances.
-template <NodeTest Test, int N>
-RAYPACK_INLINE std::uint32_t node_hits(const WideNode<N>& node, const NodeRay<N>& r, const vfloat<N>& tfar,
-                                       vfloat<N>& entry) {
-    using F = vfloat<N>;
-    if constexpr (Test == NodeTest::Ordered) {
-        const F tnx = (F::load_aligned(node.bounds[r.near_x]) - r.org.x) * r.rdir.x;
-        const F tny = (F::load_aligned(node.bounds[r.near_y]) - r.org.y) * r.rdir.y;
-        const F tnz = (F::load_aligned(node.bounds[r.near_z]) - r.org.z) * r.rdir.z;
-        const F fx = (F::load_aligned(node.bounds[r.far_x]) - r.org.x) * r.rdir_far.x;
-        const F fy = (F::load_aligned(node.bounds[r.far_y]) - r.org.y) * r.rdir_far.y;
-        const F fz = (F::load_aligned(node.bounds[r.far_z]) - r.org.z) * r.rdir_far.z;
-        // Operand order matters: tnear and tfar last, so that a NaN (a
-        // parallel ray on a plane) is dropped (see NodeTest).
-        entry = vmax(vmax(tnx, tny), vmax(tnz, r.tnear));
-        const F exit = vmin(vmin(fx, fy), vmin(fz, tfar));
-        return mask_bits(entry <= exit);
-    } else {
-        constexpr SlabMethod method = Test == NodeTest::Plain ? SlabMethod::Plain : SlabMethod::Robust;
-        const Vec3<F> lo{F::load_aligned(node.bounds[0]), F::load_aligned(node.bounds[1]),
-                         F::load_aligned(node.bounds[2])};
-        const Vec3<F> hi{F::load_aligned(node.bounds[3]), F::load_aligned(node.bounds[4]),
-                         F::load_aligned(node.bounds[5])};
-        const SlabRay<F> slab{r.org, r.rdir, r.org_rdir, r.tnear, tfar};
-        return mask_bits(intersect_box<method, F>(lo.x <= hi.x, slab, lo, hi, entry));
-    }
-}
 
 /// The nearest hit among the lanes `bits` of a block: records it and
 /// shrinks tfar.
@@ -209,14 +118,14 @@ template <int N, int M, TriangleMethod TM, NodeTest Test, bool AnyHit>
 bool trace_wide(const WideBvh<N, M>& bvh, SphereMethod sphere_method, const Rayf& ray, Hitf& hit) {
     using F = vfloat<N>;
     if (bvh.nodes.empty()) return false;
+    const NodeRay<N> nr = make_node_ray<Test, N>(ray);
+    const LeafRay<vfloat<M>> lr = make_leaf_ray<vfloat<M>>(ray, TM);
+    float tfar = ray.tfar;
     // Every level but the leaves pushes at most N - 1 entries.
     constexpr int kStackSize = (N - 1) * kBvhMaxDepth + 1;
     WideStackEntry stack[kStackSize];
     WideStackEntry* sp = stack;
-    const NodeRay<N> nr = make_node_ray<Test, N>(ray);
-    const LeafRay<vfloat<M>> lr = make_leaf_ray<vfloat<M>>(ray, TM);
     const WideNode<N>* nodes = bvh.nodes.data();
-    float tfar = ray.tfar;
     F tfar_v(tfar);
     std::uint32_t cur = 0;
     bool found = false;
