@@ -423,14 +423,14 @@ std::vector<Variant> variants() {
     std::vector<Variant> v;
     v.push_back({"bvh4", [](const Scene& s, AccelConfig c) { c.kind = "bvh4"; return build_accel(s, c); }});
     v.push_back({"bvh8", [](const Scene& s, AccelConfig c) { c.kind = "bvh8"; return build_accel(s, c); }});
-    v.push_back(variant<4, 8, NodeTest::Ordered>("bvh4 M=8"));
-    v.push_back(variant<8, 8, NodeTest::Ordered>("bvh8 M=8"));
-    v.push_back(variant<4, 4, NodeTest::Robust>("bvh4 robust slabs"));
-    v.push_back(variant<8, 4, NodeTest::Robust>("bvh8 robust slabs"));
+    v.push_back(variant<4, 4, NodeTest::Ordered>("bvh4 M=4"));
+    v.push_back(variant<8, 4, NodeTest::Ordered>("bvh8 M=4"));
+    v.push_back(variant<4, 8, NodeTest::Robust>("bvh4 robust slabs"));
+    v.push_back(variant<8, 8, NodeTest::Robust>("bvh8 robust slabs"));
     v.push_back({"bvh8 greedy collapse", [](const Scene& s, const AccelConfig& c) {
-                     CollapseConfig cc = WideBvhAccel<8, 4>::collapse_config(c);
+                     CollapseConfig cc = WideBvhAccel<8, 8>::collapse_config(c);
                      cc.method = CollapseMethod::Greedy;
-                     return std::make_unique<WideBvhAccel<8, 4>>(s, c, cc);
+                     return std::make_unique<WideBvhAccel<8, 8>>(s, c, cc);
                  }});
     return v;
 }
@@ -447,8 +447,8 @@ void check_any_structure(const Accel& a, const Scene& scene) {
     if (const auto* t = tree_of<8, 4, NodeTest::Ordered>(a)) return check_structure(*t, scene, a.stats());
     if (const auto* t = tree_of<4, 8, NodeTest::Ordered>(a)) return check_structure(*t, scene, a.stats());
     if (const auto* t = tree_of<8, 8, NodeTest::Ordered>(a)) return check_structure(*t, scene, a.stats());
-    if (const auto* t = tree_of<4, 4, NodeTest::Robust>(a)) return check_structure(*t, scene, a.stats());
-    if (const auto* t = tree_of<8, 4, NodeTest::Robust>(a)) return check_structure(*t, scene, a.stats());
+    if (const auto* t = tree_of<4, 8, NodeTest::Robust>(a)) return check_structure(*t, scene, a.stats());
+    if (const auto* t = tree_of<8, 8, NodeTest::Robust>(a)) return check_structure(*t, scene, a.stats());
     ADD_FAILURE() << "not a wide BVH: " << a.stats().name;
 }
 
@@ -465,8 +465,8 @@ void check_against_oracle(const Scene& scene, const KernelChoice& kernels, int c
     // Box faces of both trees' nodes (bvh4 and bvh8 differ above the leaves).
     std::vector<Box3f> boxes;
     for (int k = 0; k < 2; ++k) {
-        std::vector<Box3f> b = k == 0 ? child_boxes(*tree_of<4, 4, NodeTest::Ordered>(*accels[0]))
-                                      : child_boxes(*tree_of<8, 4, NodeTest::Ordered>(*accels[1]));
+        std::vector<Box3f> b = k == 0 ? child_boxes(*tree_of<4, 8, NodeTest::Ordered>(*accels[0]))
+                                      : child_boxes(*tree_of<8, 8, NodeTest::Ordered>(*accels[1]));
         boxes.insert(boxes.end(), b.begin(), b.end());
     }
     struct Set {

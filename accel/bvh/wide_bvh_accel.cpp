@@ -90,10 +90,10 @@ template class WideBvhAccel<4, 4>;
 template class WideBvhAccel<8, 4>;
 template class WideBvhAccel<8, 8>;
 template class WideBvhAccel<4, 8>;
-template class WideBvhAccel<8, 4, NodeTest::Plain>;
-template class WideBvhAccel<8, 4, NodeTest::Robust>;
-template class WideBvhAccel<4, 4, NodeTest::Plain>;
-template class WideBvhAccel<4, 4, NodeTest::Robust>;
+template class WideBvhAccel<8, 8, NodeTest::Plain>;
+template class WideBvhAccel<8, 8, NodeTest::Robust>;
+template class WideBvhAccel<4, 8, NodeTest::Plain>;
+template class WideBvhAccel<4, 8, NodeTest::Robust>;
 #endif
 
 }  // namespace raypack
