@@ -45,8 +45,12 @@ struct NodeRay {
     Vec3<F> org, rdir, rdir_far;
     Vec3<F> org_rdir;  ///< Plain only
     F tnear;
-    int near_x, near_y, near_z;  ///< rows of WideNode::bounds with the near planes ...
-    int far_x, far_y, far_z;     ///< ... and with the far planes
+    /// Byte offsets in WideNode::bounds of the rows with the near planes; a
+    /// far row is its near row's offset xor kFarFlip[axis], which keeps three
+    /// registers free in the loop.
+    std::uint32_t near_x, near_y, near_z;
+    static constexpr std::uint32_t kRow = sizeof(float) * N;
+    static constexpr std::uint32_t kFarFlip[3] = {0 ^ 3 * kRow, 1 * kRow ^ 4 * kRow, 2 * kRow ^ 5 * kRow};
 };
 
 template <NodeTest Test, int N>
@@ -71,12 +75,10 @@ RAYPACK_INLINE NodeRay<N> make_node_ray(const Rayf& ray) {
     n.rdir_far = {F(rf.x), F(rf.y), F(rf.z)};
     n.org_rdir = {F(ray.org.x * rd.x), F(ray.org.y * rd.y), F(ray.org.z * rd.z)};
     n.tnear = F(ray.tnear);
-    n.near_x = rd.x >= 0 ? 0 : 3;
-    n.near_y = rd.y >= 0 ? 1 : 4;
-    n.near_z = rd.z >= 0 ? 2 : 5;
-    n.far_x = 3 - n.near_x;
-    n.far_y = 5 - n.near_y;
-    n.far_z = 7 - n.near_z;
+    constexpr std::uint32_t row = NodeRay<N>::kRow;
+    n.near_x = rd.x >= 0 ? 0 * row : 3 * row;
+    n.near_y = rd.y >= 0 ? 1 * row : 4 * row;
+    n.near_z = rd.z >= 0 ? 2 * row : 5 * row;
     return n;
 }
 
@@ -87,13 +89,15 @@ RAYPACK_INLINE std::uint32_t node_hits(const WideNode<N>& node, const NodeRay<N>
                                        vfloat<N>& entry) {
     using F = vfloat<N>;
     if constexpr (Test == NodeTest::Ordered) {
-        auto row = [&](int i) { return F::load_aligned(node.bounds[i]); };
+        const char* base = reinterpret_cast<const char*>(node.bounds);
+        auto row = [&](std::uint32_t offset) { return F::load_aligned(reinterpret_cast<const float*>(base + offset)); };
+        constexpr const std::uint32_t* flip = NodeRay<N>::kFarFlip;
         const F nx = (row(r.near_x) - r.org.x) * r.rdir.x;
         const F ny = (row(r.near_y) - r.org.y) * r.rdir.y;
         const F nz = (row(r.near_z) - r.org.z) * r.rdir.z;
-        const F fx = (row(r.far_x) - r.org.x) * r.rdir_far.x;
-        const F fy = (row(r.far_y) - r.org.y) * r.rdir_far.y;
-        const F fz = (row(r.far_z) - r.org.z) * r.rdir_far.z;
+        const F fx = (row(r.near_x ^ flip[0]) - r.org.x) * r.rdir_far.x;
+        const F fy = (row(r.near_y ^ flip[1]) - r.org.y) * r.rdir_far.y;
+        const F fz = (row(r.near_z ^ flip[2]) - r.org.z) * r.rdir_far.z;
         // Operand order matters: tnear and tfar last, so that a NaN (a
         // parallel ray on a plane) is dropped (see NodeTest).
         entry = vmax(vmax(nx, ny), vmax(nz, r.tnear));

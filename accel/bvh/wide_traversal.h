@@ -144,6 +144,12 @@ bool trace_wide(const WideBvh<N, M>& bvh, SphereMethod sphere_method, const Rayf
                     cur = node.child[i0];
                     continue;
                 }
+                if constexpr (AnyHit) {
+                    // Occlusion needs no order: push the rest as they come.
+                    cur = node.child[i0];
+                    for (; bits != 0; bits &= bits - 1) *sp++ = {node.child[std::countr_zero(bits)], 0.0f};
+                    continue;
+                }
                 alignas(64) float dist[N];
                 entry.store_aligned(dist);
                 const int i1 = std::countr_zero(bits);
