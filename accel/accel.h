@@ -22,6 +22,8 @@ struct AccelStats {
     std::size_t bytes = 0;   ///< memory of the structure itself
     int depth = 0;
     double sah_cost = 0;     ///< SAH cost for trees, 0 where it means nothing
+    double refs_per_prim = 1;       ///< primitive references per primitive (> 1 where split or duplicated)
+    std::size_t empty_leaves = 0;   ///< empty leaves, or empty cells for the grid
 };
 
 struct AccelConfig {

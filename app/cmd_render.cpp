@@ -70,8 +70,10 @@ int run_render(const Args& args) {
     std::printf("  scene      %zu primitives (%zu spheres, %zu triangles, %zu cones), %zu lights, loaded in %.1f ms\n",
                 scene.primitive_count(), scene.spheres.size(), scene.triangles.size(), scene.cones.size(),
                 scene.lights.size(), load_ms);
-    std::printf("  structure  %s (%s), %zu nodes, SAH cost %.2f, built in %.1f ms\n", as.name.c_str(),
-                as.builder.c_str(), as.nodes, as.sah_cost, as.build_ms);
+    std::printf("  structure  %s (%s), built in %.1f ms: %zu nodes, %zu leaves (%zu empty), depth %d, "
+                "%.2f refs/prim, %.1f KiB, SAH cost %.2f\n",
+                as.name.c_str(), as.builder.c_str(), as.build_ms, as.nodes, as.leaves, as.empty_leaves, as.depth,
+                as.refs_per_prim, double(as.bytes) / 1024.0, as.sah_cost);
     std::printf("  render     %dx%d, depth %d, %d threads, primary packets of %d, Whitted: %.1f ms\n",
                 options.width, options.height, options.max_depth, limit.threads(), options.packet, stats.render_ms);
     std::printf("  rays       eye %llu (%llu hit), reflect %llu, refract %llu, shadow %llu\n",

@@ -95,6 +95,13 @@ int run_trace(const Args& args) {
         j["threads"] = limit.threads();
         j["repeat"] = repeat;
         j["build_ms"] = as.build_ms;
+        j["memory_bytes"] = as.bytes;
+        j["nodes"] = as.nodes;
+        j["leaves"] = as.leaves;
+        j["empty_leaves"] = as.empty_leaves;
+        j["depth"] = as.depth;
+        j["refs_per_prim"] = as.refs_per_prim;
+        j["sah_cost"] = as.sah_cost;
         j["trace_ms_median"] = median;
         j["trace_ms_min"] = sorted.front();
         j["trace_ms_max"] = sorted.back();

@@ -31,6 +31,8 @@ GridAccel::GridAccel(const Scene& scene, const AccelConfig& config, const GridCo
     stats_.leaves = grid_.geometry.cells() - empty_cells_;
     stats_.bytes = grid_.bytes();
     stats_.depth = 1;
+    stats_.refs_per_prim = references_per_primitive();
+    stats_.empty_leaves = empty_cells_;
 }
 
 double GridAccel::references_per_primitive() const {

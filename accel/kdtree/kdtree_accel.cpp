@@ -34,6 +34,8 @@ KdTreeAccel::KdTreeAccel(const Scene& scene, const AccelConfig& config, const Kd
     stats_.bytes = tree_.bytes();
     stats_.depth = tree_.depth;
     stats_.sah_cost = tree_.sah_cost;
+    stats_.refs_per_prim = references_per_primitive();
+    stats_.empty_leaves = tree_.empty_leaves;
 }
 
 double KdTreeAccel::references_per_primitive() const {

@@ -33,6 +33,8 @@ OctreeAccel::OctreeAccel(const Scene& scene, const AccelConfig& config, const Oc
     stats_.leaves = leaves;
     stats_.bytes = tree_.bytes();
     stats_.depth = tree_.depth;
+    stats_.refs_per_prim = references_per_primitive();
+    stats_.empty_leaves = empty_leaves_;
 }
 
 double OctreeAccel::references_per_primitive() const {
