@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <limits>
+#include <stdexcept>
 
 namespace raypack {
 namespace {
@@ -249,8 +250,11 @@ private:
                 ++runs.count[k];
             }
         }
-        if (kinds == 1 && runs.count[last_kind] <= wide_child::kMaxBlocks)
+        if (kinds == 1 && runs.count[last_kind] <= wide_child::kMaxBlocks &&
+            runs.first[last_kind] <= wide_child::kIndexMask)
             return wide_child::make_leaf(LeafKind(last_kind), runs.first[last_kind], runs.count[last_kind]);
+        if (out_.mixed.size() > wide_child::kIndexMask)
+            throw std::length_error("wide BVH: more leaf runs than a child slot can address");
         out_.mixed.push_back(runs);
         return wide_child::make_leaf(LeafKind::Mixed, std::uint32_t(out_.mixed.size() - 1), 1);
     }

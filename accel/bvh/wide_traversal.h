@@ -1,7 +1,8 @@
 #pragma once
 // One ray through an N-wide BVH: all N child boxes in one SIMD slab test,
-// the hit children pushed so that the nearest is visited first, a fixed-size
-// stack, and leaves tested M primitives at a time (Wald, Benthin, Boulos,
+// the hit children pushed so that the nearest is visited first (closest hit;
+// any hit takes them as they come), a fixed-size stack, and leaves tested M
+// primitives at a time (Wald, Benthin, Boulos,
 // "Getting Rid of Packets", RT 2008; Dammertz et al. 2008; Ernst & Greiner
 // 2008; Embree's BVHNIntersector1).
 #include <bit>
@@ -114,6 +115,9 @@ RAYPACK_INLINE bool intersect_leaf(const WideBvh<N, M>& bvh, SphereMethod sm, st
 
 /// Closest hit (AnyHit = false: `hit` gets the nearest) or any hit (returns
 /// at the first) of one ray.
+/// Closest hit (AnyHit = false: `hit` gets the nearest, the return value
+/// says whether there is one) or any hit (returns true at the first) of one
+/// ray in [tnear, tfar].
 template <int N, int M, TriangleMethod TM, NodeTest Test, bool AnyHit>
 bool trace_wide(const WideBvh<N, M>& bvh, SphereMethod sphere_method, const Rayf& ray, Hitf& hit) {
     using F = vfloat<N>;
