@@ -58,6 +58,7 @@ private:
     // child (0: no better than i - 1 slots).
     std::vector<float> cost_;
     std::vector<std::uint8_t> split_;
+    std::array<std::vector<std::uint32_t>, 3> by_kind_;  ///< emit_leaf's scratch
 
     std::uint32_t left(std::uint32_t n) const { return n + 1; }
     std::uint32_t right(std::uint32_t n) const { return bvh_.nodes[n].first; }
@@ -225,7 +226,8 @@ private:
     std::uint32_t emit_leaf(std::uint32_t v) {
         ++out_.leaves;
         const SubtreeInfo& s = info_[v];
-        std::array<std::vector<std::uint32_t>, 3> by_kind;
+        auto& by_kind = by_kind_;  // reused: no allocation per leaf
+        for (auto& list : by_kind) list.clear();
         for (std::uint32_t k = s.begin; k < s.end; ++k) {
             const std::uint32_t p = bvh_.prim_index[k];
             by_kind[std::size_t(scene_.prims[p].kind)].push_back(p);
