@@ -4,7 +4,7 @@
 For each scene: camera rays at RES x RES (raypack rays), then raypack trace
 with one thread for every structure and packet width, median of REPEAT timed
 passes after a warm-up. Prints a Markdown table of Mrays/s and ratios to the
-BVH2 at the same width. Until `raypack bench` exists (issue 6), this is how
+first structure listed (the BVH2 by default) at the same width. Until `raypack bench` exists (issue 6), this is how
 the README's structure table is made.
 
 usage: scripts/compare_structures.py [--res 1024] [--repeat 5] [SCENE ...]
@@ -39,7 +39,7 @@ def main():
     accels = args.accels.split(",")
     packets = [int(p) for p in args.packets.split(",")]
     print("| scene | K | " + " | ".join(f"{a} Mrays/s" for a in accels) + " | " +
-          " | ".join(f"{a}/bvh2" for a in accels[1:]) + " |")
+          " | ".join(f"{a}/{accels[0]}" for a in accels[1:]) + " |")
     print("|---" * (2 + 2 * len(accels) - 1) + "|")
     with tempfile.TemporaryDirectory() as tmp:
         for scene in args.scenes:
