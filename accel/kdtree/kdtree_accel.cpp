@@ -64,11 +64,11 @@ bool KdTreeAccel::trace(Rayf& ray, Hitf& hit, KdRayCounters* counters) const {
                             tree_.margin * std::fabs(rdir.z)};
     const PrimitiveIntersector<float> isect{scene_, kernels_};
     const KdNode* nodes = tree_.nodes.data();
-    struct Todo {
+    struct PendingNode {
         std::uint32_t node;
         float tmin, tmax;
     };
-    Todo stack[kKdMaxDepth + 1];
+    PendingNode stack[kKdMaxDepth + 1];
     int sp = 0;
     std::uint32_t current = 0;
     bool found = false;
@@ -117,7 +117,7 @@ bool KdTreeAccel::trace(Rayf& ray, Hitf& hit, KdRayCounters* counters) const {
         // Pop the next node the ray reaches before its closest hit so far.
         for (;;) {
             if (sp == 0) return found;
-            const Todo& t = stack[--sp];
+            const PendingNode& t = stack[--sp];
             if (t.tmin <= ray.tfar) {
                 current = t.node;
                 tmin = t.tmin;

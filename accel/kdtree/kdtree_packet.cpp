@@ -51,11 +51,11 @@ void trace_packet(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>
     const Vec3<F> slack{margin * vabs(ray.rdir.x), margin * vabs(ray.rdir.y), margin * vabs(ray.rdir.z)};
     const M positive[3] = {ray.rdir.x >= F(0.0f), ray.rdir.y >= F(0.0f), ray.rdir.z >= F(0.0f)};
     const KdNode* nodes = tree.nodes.data();
-    struct Todo {
+    struct PendingNode {
         F tmin, tmax;
         std::uint32_t node;
     };
-    Todo stack[kKdMaxDepth + 1];
+    PendingNode stack[kKdMaxDepth + 1];
     int sp = 0;
     std::uint32_t current = 0;
     for (;;) {
@@ -110,7 +110,7 @@ void trace_packet(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>
         // Pop the next node some lane reaches before its closest hit so far.
         for (;;) {
             if (sp == 0) return;
-            const Todo& t = stack[--sp];
+            const PendingNode& t = stack[--sp];
             M live = t.tmin <= vmin(t.tmax, ray.tfar);
             if constexpr (AnyHit) live = live & valid;
             if (any(live)) {
