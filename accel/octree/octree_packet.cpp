@@ -3,6 +3,7 @@
 #include <bit>
 #include <limits>
 
+#include "accel/packet_driver.h"
 #include "accel/packet_intersector.h"
 #include "kernels/aabb.h"
 #include "kernels/ray_packet.h"
@@ -148,30 +149,10 @@ void octree_trace_packets(const Octree& tree, const Scene& scene, KernelChoice k
         return;
     }
     const PacketPrimitiveIntersector<F> isect{&scene, kernels};
-    for (std::size_t first = 0; first < rays.size(); first += K) {
-        const std::size_t n = std::min<std::size_t>(K, rays.size() - first);
-        vmask<K> valid;
-        RayPacket<K> ray = load_packet<K>(rays.subspan(first, n), valid);
-        HitPacket<K> hit;
-        hit.t = F(std::numeric_limits<float>::infinity());
-        hit.u = hit.v = F(0.0f);
-        for (auto& p : hit.prim) p = kNoPrim;
-        vmask<K> occluded = valid & !valid;
+    trace_in_packets<K, AnyHit>(rays, hits, [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid,
+                                                vmask<K>& occluded) {
         trace_packet<K, AnyHit>(tree, isect, ray, hit, valid, occluded);
-        alignas(64) float t[K], u[K], v[K];
-        store_lanes(t, hit.t);
-        store_lanes(u, hit.u);
-        store_lanes(v, hit.v);
-        const std::uint32_t occ = mask_bits(occluded);
-        for (std::size_t i = 0; i < n; ++i) {
-            if constexpr (AnyHit) {
-                hits[first + i] = Hitf{};
-                if ((occ >> i) & 1u) hits[first + i].prim = 0;
-            } else {
-                hits[first + i] = Hitf{t[i], hit.prim[i], u[i], v[i]};
-            }
-        }
-    }
+    });
 }
 
 #if defined(__SSE4_2__)

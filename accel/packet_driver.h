@@ -1,0 +1,44 @@
+#pragma once
+// The loop every packet traversal shares: cut the rays into packets of K
+// (the last one ragged, its missing lanes inactive), trace each, and write
+// the hits back in the exchange layout (for any hit, prim 0 = occluded).
+#include <algorithm>
+#include <limits>
+#include <span>
+
+#include "kernels/ray_packet.h"
+
+namespace raypack {
+
+/// `trace_packet(ray, hit, valid, occluded)` traces one packet: it records
+/// closest hits in `hit`, or sets the `occluded` lanes for any-hit queries.
+template <int K, bool AnyHit, class TracePacket>
+void trace_in_packets(std::span<const Rayf> rays, std::span<Hitf> hits, TracePacket&& trace_packet) {
+    using F = vfloat<K>;
+    for (std::size_t first = 0; first < rays.size(); first += K) {
+        const std::size_t n = std::min<std::size_t>(K, rays.size() - first);
+        vmask<K> valid;
+        RayPacket<K> ray = load_packet<K>(rays.subspan(first, n), valid);
+        HitPacket<K> hit;
+        hit.t = F(std::numeric_limits<float>::infinity());
+        hit.u = hit.v = F(0.0f);
+        for (auto& p : hit.prim) p = kNoPrim;
+        vmask<K> occluded = valid & !valid;
+        trace_packet(ray, hit, valid, occluded);
+        alignas(64) float t[K], u[K], v[K];
+        store_lanes(t, hit.t);
+        store_lanes(u, hit.u);
+        store_lanes(v, hit.v);
+        const std::uint32_t occ = mask_bits(occluded);
+        for (std::size_t i = 0; i < n; ++i) {
+            if constexpr (AnyHit) {
+                hits[first + i] = Hitf{};
+                if ((occ >> i) & 1u) hits[first + i].prim = 0;
+            } else {
+                hits[first + i] = Hitf{t[i], hit.prim[i], u[i], v[i]};
+            }
+        }
+    }
+}
+
+}  // namespace raypack
