@@ -1,29 +1,18 @@
 #include "accel/bvh/bvh2_accel.h"
 
-#include "accel/bvh/bvh2_packet.h"
-#include "kernels/simd.h"
-
 #include <chrono>
 #include <stdexcept>
 #include <vector>
+
+#include "accel/bvh/build_from_scene.h"
+#include "accel/bvh/bvh2_packet.h"
+#include "kernels/simd.h"
 
 namespace raypack {
 
 Bvh2Accel::Bvh2Accel(const Scene& scene, const AccelConfig& config) : scene_(&scene), kernels_(config.kernels) {
     const auto start = std::chrono::steady_clock::now();
-    const std::size_t n = scene.primitive_count();
-    std::vector<Box3f> boxes(n);
-    std::vector<Vec3f> centers(n);
-    for (std::uint32_t i = 0; i < n; ++i) {
-        boxes[i] = primitive_bounds(scene, i);
-        centers[i] = boxes[i].center();
-    }
-    BinnedSahConfig bc;
-    bc.bins = config.sah_bins;
-    bc.max_leaf_size = config.max_leaf_size;
-    bc.traversal_cost = config.traversal_cost;
-    bc.intersection_cost = config.intersection_cost;
-    bvh_ = build_binned_sah(boxes, centers, bc);
+    bvh_ = build_scene_bvh2(scene, config);
     const auto stop = std::chrono::steady_clock::now();
     stats_.name = "bvh2";
     stats_.builder = "binned";
@@ -32,7 +21,7 @@ Bvh2Accel::Bvh2Accel(const Scene& scene, const AccelConfig& config) : scene_(&sc
     stats_.leaves = bvh_.leaves;
     stats_.depth = bvh_.depth;
     stats_.bytes = bvh_.nodes.size() * sizeof(Bvh2Node) + bvh_.prim_index.size() * sizeof(std::uint32_t);
-    stats_.sah_cost = sah_cost(bvh_, bc.traversal_cost, bc.intersection_cost);
+    stats_.sah_cost = sah_cost(bvh_, config.traversal_cost, config.intersection_cost);
 }
 
 // Depth-first traversal, nearer child first, with an explicit stack.

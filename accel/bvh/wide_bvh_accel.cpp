@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "accel/bvh/binned_sah_builder.h"
+#include "accel/bvh/build_from_scene.h"
 
 namespace raypack {
 
@@ -29,19 +30,7 @@ template <int N, int M, NodeTest Test>
 WideBvhAccel<N, M, Test>::WideBvhAccel(const Scene& scene, const AccelConfig& config, const CollapseConfig& collapse)
     : kernels_(config.kernels) {
     const auto start = std::chrono::steady_clock::now();
-    const std::size_t n = scene.primitive_count();
-    std::vector<Box3f> boxes(n);
-    std::vector<Vec3f> centers(n);
-    for (std::uint32_t i = 0; i < n; ++i) {
-        boxes[i] = primitive_bounds(scene, i);
-        centers[i] = boxes[i].center();
-    }
-    BinnedSahConfig bc;
-    bc.bins = config.sah_bins;
-    bc.max_leaf_size = config.max_leaf_size;
-    bc.traversal_cost = config.traversal_cost;
-    bc.intersection_cost = config.intersection_cost;
-    const Bvh2 binary = build_binned_sah(boxes, centers, bc);
+    const Bvh2 binary = build_scene_bvh2(scene, config);
     CollapseConfig cc = collapse;
     cc.triangle_layout = collapse_config(config).triangle_layout;  // must match the kernel that runs
     bvh_ = collapse_bvh<N, M>(binary, scene, cc);
