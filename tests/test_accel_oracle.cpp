@@ -17,12 +17,15 @@
 #include <string>
 #include <vector>
 
+#include "tests/oracle_harness.h"
 #include "accel/accel.h"
 #include "accel/brute/brute_force.h"
 #include "render/camera_rays.h"
 #include "scene/load.h"
 
 namespace raypack {
+
+using namespace raypack::oracle_harness;
 namespace {
 
 /// Every scenes/*.nff plus the bunny, found on disk so that new scenes join in.
@@ -41,22 +44,6 @@ std::vector<std::string> accel_kinds_under_test() {
     kinds.push_back("embree");
 #endif
     return kinds;
-}
-
-std::string describe(const Rayf& r) {
-    std::ostringstream os;
-    os << std::hexfloat << "org (" << r.org.x << ", " << r.org.y << ", " << r.org.z << ") dir (" << r.dir.x << ", "
-       << r.dir.y << ", " << r.dir.z << ") tnear " << r.tnear << " tfar " << r.tfar << std::defaultfloat << " ["
-       << r.org.x << ", " << r.org.y << ", " << r.org.z << " / " << r.dir.x << ", " << r.dir.y << ", " << r.dir.z
-       << "]";
-    return os.str();
-}
-
-std::string describe(const Hitf& h) {
-    if (!h.found()) return "miss";
-    std::ostringstream os;
-    os << "prim " << h.prim << " t " << std::setprecision(9) << h.t;
-    return os.str();
 }
 
 /// Both structures on both cores; Accel::intersect / occluded are const.
@@ -89,20 +76,6 @@ std::vector<Rayf> camera_rays(const Scene& scene, int size) {
     for (int y = 0; y < size; ++y)
         for (int x = 0; x < size; ++x) rays.push_back(camera_ray(f, float(x) + 0.5f, float(y) + 0.5f));
     return rays;
-}
-
-Vec3f random_direction(std::mt19937& rng) {
-    std::normal_distribution<float> n;
-    for (;;) {
-        const Vec3f d{n(rng), n(rng), n(rng)};
-        if (dot(d, d) > 1e-6f) return normalize(d);
-    }
-}
-
-Vec3f random_point(std::mt19937& rng, const Box3f& box) {
-    std::uniform_real_distribution<float> u(0, 1);
-    const Vec3f e = box.extent();
-    return {box.lo.x + u(rng) * e.x, box.lo.y + u(rng) * e.y, box.lo.z + u(rng) * e.z};
 }
 
 /// Origins uniform in the scene box, directions uniform on the sphere; half
@@ -142,9 +115,6 @@ Vec3f extreme_point(const Scene& s, std::uint32_t p, std::mt19937& rng) {
     }
     return {};
 }
-
-/// Zero with a random sign.
-float signed_zero(std::mt19937& rng) { return rng() % 2 ? 0.0f : -0.0f; }
 
 std::vector<Rayf> adversarial_rays(const Scene& scene, std::mt19937& rng) {
     std::vector<Rayf> rays;
@@ -208,25 +178,6 @@ std::vector<Rayf> adversarial_rays(const Scene& scene, std::mt19937& rng) {
         rays.push_back(r);
     }
     return rays;
-}
-
-/// Shadow rays from the closest hits towards every light (any-hit, the
-/// segment between the two points, ends excluded by a small margin).
-std::vector<Rayf> shadow_rays(const Scene& scene, const std::vector<Rayf>& rays, const std::vector<Hitf>& hits) {
-    std::vector<Rayf> out;
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-        if (!hits[i].found()) continue;
-        const Vec3f p = rays[i].org + rays[i].dir * hits[i].t;
-        for (const PointLight& light : scene.lights) {
-            Rayf s;
-            s.org = p;
-            s.dir = light.position - p;
-            s.tnear = 1e-4f;
-            s.tfar = 1.0f - 1e-4f;
-            out.push_back(s);
-        }
-    }
-    return out;
 }
 
 // ---- Comparisons -----------------------------------------------------------------
@@ -356,12 +307,6 @@ TEST_P(AccelOracle, MatchesBruteForce) {
                                            << " occlusion answers differ" << a.first;
         }
     }
-}
-
-std::string param_name(const ::testing::TestParamInfo<std::string>& info) {
-    std::string s = info.param;
-    std::replace(s.begin(), s.end(), '.', '_');
-    return s;
 }
 
 // Empty instantiation name: the tests are called AccelOracle.MatchesBruteForce/<scene>.

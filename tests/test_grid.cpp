@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "tests/oracle_harness.h"
 #include "accel/accel.h"
 #include "accel/brute/brute_force.h"
 #include "accel/grid/dda.h"
@@ -34,25 +35,11 @@
 #include "scene/load.h"
 
 namespace raypack::grid_test {
+
+using namespace raypack::oracle_harness;
 namespace {
 
 // ---- Tracing and comparing --------------------------------------------------------
-
-std::string describe(const Rayf& r) {
-    std::ostringstream os;
-    os << std::hexfloat << "org (" << r.org.x << ", " << r.org.y << ", " << r.org.z << ") dir (" << r.dir.x << ", "
-       << r.dir.y << ", " << r.dir.z << ") tnear " << r.tnear << " tfar " << r.tfar << std::defaultfloat << " ["
-       << r.org.x << ", " << r.org.y << ", " << r.org.z << " / " << r.dir.x << ", " << r.dir.y << ", " << r.dir.z
-       << "]";
-    return os.str();
-}
-
-std::string describe(const Hitf& h) {
-    if (!h.found()) return "miss";
-    std::ostringstream os;
-    os << "prim " << h.prim << " t " << std::setprecision(9) << h.t;
-    return os.str();
-}
 
 std::vector<Hitf> trace(const Accel& accel, const std::vector<Rayf>& rays) {
     std::vector<Hitf> hits(rays.size());
@@ -130,29 +117,6 @@ std::vector<Rayf> camera_rays(const Scene& scene, int size) {
     for (int y = 0; y < size; ++y)
         for (int x = 0; x < size; ++x) rays.push_back(camera_ray(f, float(x) + 0.5f, float(y) + 0.5f));
     return rays;
-}
-
-Vec3f random_direction(std::mt19937& rng) {
-    std::normal_distribution<float> n;
-    for (;;) {
-        const Vec3f d{n(rng), n(rng), n(rng)};
-        if (dot(d, d) > 1e-6f) return normalize(d);
-    }
-}
-
-Vec3f random_point(std::mt19937& rng, const Box3f& box) {
-    std::uniform_real_distribution<float> u(0, 1);
-    const Vec3f e = box.extent();
-    return {box.lo.x + u(rng) * e.x, box.lo.y + u(rng) * e.y, box.lo.z + u(rng) * e.z};
-}
-
-float signed_zero(std::mt19937& rng) { return rng() % 2 ? 0.0f : -0.0f; }
-
-Box3f grown(Box3f b, float f) {
-    const Vec3f e = b.extent() * f;
-    b.lo -= e;
-    b.hi += e;
-    return b;
 }
 
 std::vector<Rayf> random_rays(const Scene& scene, std::mt19937& rng, int n) {
@@ -284,23 +248,6 @@ std::vector<Rayf> grid_adversarial_rays(const GridGeometry& g, const Scene& scen
     return rays;
 }
 
-std::vector<Rayf> shadow_rays(const Scene& scene, const std::vector<Rayf>& rays, const std::vector<Hitf>& hits) {
-    std::vector<Rayf> out;
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-        if (!hits[i].found()) continue;
-        const Vec3f p = rays[i].org + rays[i].dir * hits[i].t;
-        for (const PointLight& light : scene.lights) {
-            Rayf s;
-            s.org = p;
-            s.dir = light.position - p;
-            s.tnear = 1e-4f;
-            s.tfar = 1.0f - 1e-4f;
-            out.push_back(s);
-        }
-    }
-    return out;
-}
-
 std::unique_ptr<GridAccel> make_grid(const Scene& scene, const GridConfig& gc = {}) {
     return std::make_unique<GridAccel>(scene, AccelConfig{}, gc);
 }
@@ -355,12 +302,6 @@ TEST_P(Grid, MatchesBruteForce) {
     EXPECT_LT(cells_per_prim, lambda * 3.0);
     RecordProperty("cells", std::to_string(grid.cell_count()));
     RecordProperty("refs_per_prim", std::to_string(grid.references_per_primitive()));
-}
-
-std::string param_name(const ::testing::TestParamInfo<std::string>& info) {
-    std::string s = info.param;
-    std::replace(s.begin(), s.end(), '.', '_');
-    return s;
 }
 
 INSTANTIATE_TEST_SUITE_P(, Grid, ::testing::ValuesIn(scene_files()), param_name);

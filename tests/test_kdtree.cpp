@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "tests/oracle_harness.h"
 #include "accel/accel.h"
 #include "accel/brute/brute_force.h"
 #include "accel/kdtree/kdtree_accel.h"
@@ -28,25 +29,11 @@
 #include "scene/load.h"
 
 namespace raypack::kdtree_test {
+
+using namespace raypack::oracle_harness;
 namespace {
 
 // ---- Tracing and comparing --------------------------------------------------------
-
-std::string describe(const Rayf& r) {
-    std::ostringstream os;
-    os << std::hexfloat << "org (" << r.org.x << ", " << r.org.y << ", " << r.org.z << ") dir (" << r.dir.x << ", "
-       << r.dir.y << ", " << r.dir.z << ") tnear " << r.tnear << " tfar " << r.tfar << std::defaultfloat << " ["
-       << r.org.x << ", " << r.org.y << ", " << r.org.z << " / " << r.dir.x << ", " << r.dir.y << ", " << r.dir.z
-       << "]";
-    return os.str();
-}
-
-std::string describe(const Hitf& h) {
-    if (!h.found()) return "miss";
-    std::ostringstream os;
-    os << "prim " << h.prim << " t " << std::setprecision(9) << h.t;
-    return os.str();
-}
 
 /// Closest hits of `rays` in packets of `width` (1: single rays), on both cores.
 std::vector<Hitf> trace(const Accel& accel, const std::vector<Rayf>& rays, int width = 1) {
@@ -156,29 +143,6 @@ std::vector<Rayf> camera_rays(const Scene& scene, int size) {
     for (int y = 0; y < size; ++y)
         for (int x = 0; x < size; ++x) rays.push_back(camera_ray(f, float(x) + 0.5f, float(y) + 0.5f));
     return rays;
-}
-
-Vec3f random_direction(std::mt19937& rng) {
-    std::normal_distribution<float> n;
-    for (;;) {
-        const Vec3f d{n(rng), n(rng), n(rng)};
-        if (dot(d, d) > 1e-6f) return normalize(d);
-    }
-}
-
-Vec3f random_point(std::mt19937& rng, const Box3f& box) {
-    std::uniform_real_distribution<float> u(0, 1);
-    const Vec3f e = box.extent();
-    return {box.lo.x + u(rng) * e.x, box.lo.y + u(rng) * e.y, box.lo.z + u(rng) * e.z};
-}
-
-float signed_zero(std::mt19937& rng) { return rng() % 2 ? 0.0f : -0.0f; }
-
-Box3f grown(Box3f b, float f) {
-    const Vec3f e = b.extent() * f;
-    b.lo -= e;
-    b.hi += e;
-    return b;
 }
 
 std::vector<Rayf> random_rays(const Scene& scene, std::mt19937& rng, int n) {
@@ -339,23 +303,6 @@ std::vector<Rayf> adversarial_rays(const raypack::KdTree& tree, const Scene& sce
     return rays;
 }
 
-std::vector<Rayf> shadow_rays(const Scene& scene, const std::vector<Rayf>& rays, const std::vector<Hitf>& hits) {
-    std::vector<Rayf> out;
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-        if (!hits[i].found()) continue;
-        const Vec3f p = rays[i].org + rays[i].dir * hits[i].t;
-        for (const PointLight& light : scene.lights) {
-            Rayf s;
-            s.org = p;
-            s.dir = light.position - p;
-            s.tnear = 1e-4f;
-            s.tfar = 1.0f - 1e-4f;
-            out.push_back(s);
-        }
-    }
-    return out;
-}
-
 std::unique_ptr<KdTreeAccel> make_tree(const Scene& scene, const KdTreeConfig& kc = {}) {
     return std::make_unique<KdTreeAccel>(scene, AccelConfig{}, kc);
 }
@@ -456,12 +403,6 @@ TEST_P(KdTree, MatchesBruteForce) {
     EXPECT_LE(s.depth, int(std::lround(8 + 1.3 * std::floor(std::log2(double(scene.primitive_count()))))));
     RecordProperty("nodes", std::to_string(s.nodes));
     RecordProperty("refs_per_prim", std::to_string(tree.references_per_primitive()));
-}
-
-std::string param_name(const ::testing::TestParamInfo<std::string>& info) {
-    std::string s = info.param;
-    std::replace(s.begin(), s.end(), '.', '_');
-    return s;
 }
 
 INSTANTIATE_TEST_SUITE_P(, KdTree, ::testing::ValuesIn(scene_files()), param_name);

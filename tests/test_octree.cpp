@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "tests/oracle_harness.h"
 #include "accel/accel.h"
 #include "accel/brute/brute_force.h"
 #include "accel/grid/triangle_box_overlap.h"
@@ -30,25 +31,11 @@
 #include "scene/load.h"
 
 namespace raypack::octree_test {
+
+using namespace raypack::oracle_harness;
 namespace {
 
 // ---- Tracing and comparing --------------------------------------------------------
-
-std::string describe(const Rayf& r) {
-    std::ostringstream os;
-    os << std::hexfloat << "org (" << r.org.x << ", " << r.org.y << ", " << r.org.z << ") dir (" << r.dir.x << ", "
-       << r.dir.y << ", " << r.dir.z << ") tnear " << r.tnear << " tfar " << r.tfar << std::defaultfloat << " ["
-       << r.org.x << ", " << r.org.y << ", " << r.org.z << " / " << r.dir.x << ", " << r.dir.y << ", " << r.dir.z
-       << "]";
-    return os.str();
-}
-
-std::string describe(const Hitf& h) {
-    if (!h.found()) return "miss";
-    std::ostringstream os;
-    os << "prim " << h.prim << " t " << std::setprecision(9) << h.t;
-    return os.str();
-}
 
 /// Both cores; packets of `width` (1 = single rays), in chunks that are
 /// multiples of 16 so that packets are the same whatever the schedule.
@@ -150,29 +137,6 @@ std::vector<Rayf> camera_rays(const Scene& scene, int size) {
                 for (int x = tx; x < std::min(size, tx + 4); ++x)
                     rays.push_back(camera_ray(f, float(x) + 0.5f, float(y) + 0.5f));
     return rays;
-}
-
-Vec3f random_direction(std::mt19937& rng) {
-    std::normal_distribution<float> n;
-    for (;;) {
-        const Vec3f d{n(rng), n(rng), n(rng)};
-        if (dot(d, d) > 1e-6f) return normalize(d);
-    }
-}
-
-Vec3f random_point(std::mt19937& rng, const Box3f& box) {
-    std::uniform_real_distribution<float> u(0, 1);
-    const Vec3f e = box.extent();
-    return {box.lo.x + u(rng) * e.x, box.lo.y + u(rng) * e.y, box.lo.z + u(rng) * e.z};
-}
-
-float signed_zero(std::mt19937& rng) { return rng() % 2 ? 0.0f : -0.0f; }
-
-Box3f grown(Box3f b, float f) {
-    const Vec3f e = b.extent() * f;
-    b.lo -= e;
-    b.hi += e;
-    return b;
 }
 
 std::vector<Rayf> random_rays(const Scene& scene, std::mt19937& rng, int n) {
@@ -309,23 +273,6 @@ std::vector<Rayf> octree_adversarial_rays(const Octree& tree, const Scene& scene
     return rays;
 }
 
-std::vector<Rayf> shadow_rays(const Scene& scene, const std::vector<Rayf>& rays, const std::vector<Hitf>& hits) {
-    std::vector<Rayf> out;
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-        if (!hits[i].found()) continue;
-        const Vec3f p = rays[i].org + rays[i].dir * hits[i].t;
-        for (const PointLight& light : scene.lights) {
-            Rayf s;
-            s.org = p;
-            s.dir = light.position - p;
-            s.tnear = 1e-4f;
-            s.tfar = 1.0f - 1e-4f;
-            out.push_back(s);
-        }
-    }
-    return out;
-}
-
 std::unique_ptr<OctreeAccel> make_octree(const Scene& scene, const OctreeConfig& oc = {}) {
     return std::make_unique<OctreeAccel>(scene, AccelConfig{}, oc);
 }
@@ -342,11 +289,11 @@ void expect_well_formed(const OctreeAccel& accel, const Scene& scene, const Octr
     std::size_t leaves = 0, empty = 0, refs = 0;
     int depth = 0;
     // Depth of each node by a walk from the root.
-    std::vector<std::pair<std::uint32_t, int>> todo = {{0, 0}};
+    std::vector<std::pair<std::uint32_t, int>> pending = {{0, 0}};
     std::vector<bool> seen(t.nodes.size(), false);
-    while (!todo.empty()) {
-        const auto [i, d] = todo.back();
-        todo.pop_back();
+    while (!pending.empty()) {
+        const auto [i, d] = pending.back();
+        pending.pop_back();
         ASSERT_LT(i, t.nodes.size());
         ASSERT_FALSE(seen[i]);
         seen[i] = true;
@@ -366,7 +313,7 @@ void expect_well_formed(const OctreeAccel& accel, const Scene& scene, const Octr
             }
         } else {
             EXPECT_LT(d, oc.max_depth);
-            for (std::uint32_t c = 0; c < 8; ++c) todo.push_back({node.first + c, d + 1});
+            for (std::uint32_t c = 0; c < 8; ++c) pending.push_back({node.first + c, d + 1});
         }
     }
     EXPECT_EQ(std::count(seen.begin(), seen.end(), false), 0);
@@ -424,12 +371,6 @@ TEST_P(Octree, MatchesBruteForce) {
     expect_well_formed(octree, scene, OctreeConfig{});
     RecordProperty("nodes", std::to_string(octree.stats().nodes));
     RecordProperty("refs_per_prim", std::to_string(octree.references_per_primitive()));
-}
-
-std::string param_name(const ::testing::TestParamInfo<std::string>& info) {
-    std::string s = info.param;
-    std::replace(s.begin(), s.end(), '.', '_');
-    return s;
 }
 
 INSTANTIATE_TEST_SUITE_P(, Octree, ::testing::ValuesIn(scene_files()), param_name);

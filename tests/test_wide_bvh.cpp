@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "tests/oracle_harness.h"
 #include "accel/accel.h"
 #include "accel/brute/brute_force.h"
 #include "accel/bvh/wide_bvh_accel.h"
@@ -30,6 +31,8 @@
 #include "scene/load.h"
 
 namespace raypack::wide_bvh_test {
+
+using namespace raypack::oracle_harness;
 namespace {
 
 std::vector<std::string> scene_files() {
@@ -39,20 +42,6 @@ std::vector<std::string> scene_files() {
     std::sort(files.begin(), files.end());
     files.push_back("bunny.obj");
     return files;
-}
-
-std::string describe(const Rayf& r) {
-    std::ostringstream os;
-    os << std::hexfloat << "org (" << r.org.x << ", " << r.org.y << ", " << r.org.z << ") dir (" << r.dir.x << ", "
-       << r.dir.y << ", " << r.dir.z << ") tnear " << r.tnear << " tfar " << r.tfar;
-    return os.str();
-}
-
-std::string describe(const Hitf& h) {
-    if (!h.found()) return "miss";
-    std::ostringstream os;
-    os << "prim " << h.prim << " t " << std::setprecision(9) << h.t;
-    return os.str();
 }
 
 std::vector<Hitf> trace(const Accel& accel, const std::vector<Rayf>& rays) {
@@ -83,20 +72,6 @@ std::vector<Rayf> camera_rays(const Scene& scene, int size) {
     return rays;
 }
 
-Vec3f random_direction(std::mt19937& rng) {
-    std::normal_distribution<float> n;
-    for (;;) {
-        const Vec3f d{n(rng), n(rng), n(rng)};
-        if (dot(d, d) > 1e-6f) return normalize(d);
-    }
-}
-
-Vec3f random_point(std::mt19937& rng, const Box3f& box) {
-    std::uniform_real_distribution<float> u(0, 1);
-    const Vec3f e = box.extent();
-    return {box.lo.x + u(rng) * e.x, box.lo.y + u(rng) * e.y, box.lo.z + u(rng) * e.z};
-}
-
 std::vector<Rayf> random_rays(const Scene& scene, std::mt19937& rng, int n) {
     const Box3f box = scene_bounds(scene);
     const float diag = length(box.extent());
@@ -109,8 +84,6 @@ std::vector<Rayf> random_rays(const Scene& scene, std::mt19937& rng, int n) {
     }
     return rays;
 }
-
-float signed_zero(std::mt19937& rng) { return rng() % 2 ? 0.0f : -0.0f; }
 
 /// A point of primitive p on its bounding box: a vertex, the top of a
 /// sphere, the centre of a cone end.
@@ -211,23 +184,6 @@ std::vector<Rayf> adversarial_rays(const Scene& scene, const std::vector<Box3f>&
         rays.push_back(r);
     }
     return rays;
-}
-
-std::vector<Rayf> shadow_rays(const Scene& scene, const std::vector<Rayf>& rays, const std::vector<Hitf>& hits) {
-    std::vector<Rayf> out;
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-        if (!hits[i].found()) continue;
-        const Vec3f p = rays[i].org + rays[i].dir * hits[i].t;
-        for (const PointLight& light : scene.lights) {
-            Rayf s;
-            s.org = p;
-            s.dir = light.position - p;
-            s.tnear = 1e-4f;
-            s.tfar = 1.0f - 1e-4f;
-            out.push_back(s);
-        }
-    }
-    return out;
 }
 
 // ---- Comparisons -----------------------------------------------------------------
@@ -516,12 +472,6 @@ TEST_P(WideBvh, MatchesBruteForce) {
     // The bunny's 69k triangles make the oracle the slow part: fewer rays.
     const bool big = scene.primitive_count() > 20000;
     check_against_oracle(scene, KernelChoice{}, big ? 40 : 64, big ? 1000 : 2000, GetParam());
-}
-
-std::string param_name(const ::testing::TestParamInfo<std::string>& info) {
-    std::string s = info.param;
-    std::replace(s.begin(), s.end(), '.', '_');
-    return s;
 }
 
 INSTANTIATE_TEST_SUITE_P(, WideBvh, ::testing::ValuesIn(scene_files()), param_name);
