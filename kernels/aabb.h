@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "kernels/ray.h"
+#include "kernels/fused.h"
 #include "kernels/simd.h"
 
 namespace raypack {
@@ -93,9 +94,12 @@ RAYPACK_INLINE mask_of<F> intersect_box(const mask_of<F>& valid, const SlabRay<F
     F tx0, tx1, ty0, ty1, tz0, tz1;
     mask_of<F> ok = valid;
     if constexpr (Method == SlabMethod::Plain) {
-        tx0 = vfmsub(lo.x, rdir.x, ray.org_rdir.x), tx1 = vfmsub(hi.x, rdir.x, ray.org_rdir.x);
-        ty0 = vfmsub(lo.y, rdir.y, ray.org_rdir.y), ty1 = vfmsub(hi.y, rdir.y, ray.org_rdir.y);
-        tz0 = vfmsub(lo.z, rdir.z, ray.org_rdir.z), tz1 = vfmsub(hi.z, rdir.z, ray.org_rdir.z);
+        // Each is used twice: load once (see keep_in_register).
+        Vec3<F> r = rdir, od = ray.org_rdir;
+        keep_in_register(r), keep_in_register(od);
+        tx0 = vfmsub(lo.x, r.x, od.x), tx1 = vfmsub(hi.x, r.x, od.x);
+        ty0 = vfmsub(lo.y, r.y, od.y), ty1 = vfmsub(hi.y, r.y, od.y);
+        tz0 = vfmsub(lo.z, r.z, od.z), tz1 = vfmsub(hi.z, r.z, od.z);
     } else {
         tx0 = (lo.x - org.x) * rdir.x, tx1 = (hi.x - org.x) * rdir.x;
         ty0 = (lo.y - org.y) * rdir.y, ty1 = (hi.y - org.y) * rdir.y;

@@ -7,6 +7,12 @@
 
 namespace raypack {
 
+/// keep_in_register (simd.h) for each component.
+template <class F>
+RAYPACK_INLINE void keep_in_register(Vec3<F>& v) {
+    keep_in_register(v.x), keep_in_register(v.y), keep_in_register(v.z);
+}
+
 /// a . b as one product and two fused multiply-adds.
 template <class F>
 RAYPACK_INLINE F fused_dot(const Vec3<F>& a, const Vec3<F>& b) {
