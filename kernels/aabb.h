@@ -118,8 +118,11 @@ RAYPACK_INLINE mask_of<F> intersect_box(const mask_of<F>& valid, const SlabRay<F
     }
     const F t_in = vmax(vmax(vmin(tx0, tx1), vmin(ty0, ty1)), vmax(vmin(tz0, tz1), ray.tnear));
     F t_out = vmin(vmin(vmax(tx0, tx1), vmax(ty0, ty1)), vmax(tz0, tz1));
-    if constexpr (Method == SlabMethod::Robust) t_out = t_out * F(1.0f + 2.0f * rounding_gamma<float>(3));
     t_out = vmin(t_out, ray.tfar);
+    // Widened after the clamp: a hit exactly at tfar (tnear == tfar == t, or a
+    // shadow ray ending on a surface) must not lose its box to the rounding of
+    // the entry distance.
+    if constexpr (Method == SlabMethod::Robust) t_out = t_out * F(1.0f + 2.0f * rounding_gamma<float>(3));
     entry = t_in;
     return ok & (t_in <= t_out);
 }

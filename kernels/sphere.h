@@ -6,7 +6,9 @@
 // starting inside the sphere hits the far side. `t` is meaningful on the
 // returned lanes only. dir need not be unit length. Each variant takes the ray
 // as a QuadricRay (|dir|^2 and its reciprocal precomputed once per ray) or as
-// its fields.
+// its fields. A sphere whose squared radius is zero (r = 0, or r < ~1e-19 in
+// float) is a point and never hit, as degenerate triangles are not: otherwise
+// a ray passing it at 1e-30 would hit it by underflow, outside its box.
 #include "kernels/quadratic.h"
 #include "kernels/ray.h"
 
@@ -23,9 +25,10 @@ RAYPACK_INLINE mask_of<F> intersect_sphere_algebraic(mask_of<F> valid, const Qua
                                                          const Vec3<F>& center, const F& radius, F& t) {
     const Vec3<F> oc = (ray.org - center);
     const F b = fused_dot(oc, ray.dir);
-    const F c = fused_dot(oc, oc) - radius * radius;
+    const F r2 = radius * radius;
+    const F c = fused_dot(oc, oc) - r2;
     const F disc = vfmsub(b, b, ray.dd * c);
-    valid = valid & (disc >= F(0));
+    valid = valid & (disc >= F(0)) & (r2 > F(0));
     if (none(valid)) return valid;
     const F root = vsqrt(disc);
     const F nb = -b;
@@ -44,7 +47,7 @@ RAYPACK_INLINE mask_of<F> intersect_sphere_geometric(mask_of<F> valid, const Qua
     const Vec3<F> perp = fused_sub_scaled(l, ray.dir, tca);  // centre minus closest point
     const F d2 = fused_dot(perp, perp);                      // squared distance centre-ray
     const F r2 = radius * radius;
-    valid = valid & (d2 <= r2);
+    valid = valid & (d2 <= r2) & (r2 > F(0));
     if (none(valid)) return valid;
     const F thc = vsqrt((r2 - d2) * ray.inv_dd);
     return nearest_root(valid, tca - thc, tca + thc, ray.tnear, ray.tfar, t);
@@ -64,7 +67,7 @@ RAYPACK_INLINE mask_of<F> intersect_sphere_precise(mask_of<F> valid, const Quadr
     const Vec3<F> l = fused_sub_scaled(f, ray.dir, b * ray.inv_dd);  // f minus its projection on the ray
     const F r2 = radius * radius;
     const F h2 = r2 - fused_dot(l, l);  // discriminant / a
-    valid = valid & (h2 >= F(0));
+    valid = valid & (h2 >= F(0)) & (r2 > F(0));
     if (none(valid)) return valid;
     // c with the same r2 as h2: then h2 == 0 with b == 0 (a tangent ray from
     // the surface) gives c == 0 and the 0 / 0 below is dropped by vmin/vmax.
