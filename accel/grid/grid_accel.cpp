@@ -131,6 +131,20 @@ bool GridAccel::occluded_counting(const Rayf& ray_in, GridRayCounters& counters)
     return trace<true, true>(ray, hit, &counters);
 }
 
+bool GridAccel::count_traversal(std::span<const Rayf> rays, bool any_hit, std::span<Hitf> hits,
+                               TraversalCounts& counts) const {
+    GridRayCounters c;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        Rayf ray = rays[i];
+        Hitf hit;
+        const bool found = any_hit ? trace<true, true>(ray, hit, &c) : trace<false, true>(ray, hit, &c);
+        hits[i] = found ? hit : Hitf{};
+    }
+    counts.nodes += c.cells_visited;
+    counts.prims += c.prim_tests;
+    return true;
+}
+
 bool GridAccel::supports_packet(int width) const {
     return width == 1 || (width == 4 && kWidthCompiled<4>) || (width == 8 && kWidthCompiled<8>) ||
            (width == 16 && kWidthCompiled<16>);

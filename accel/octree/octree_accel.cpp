@@ -172,6 +172,20 @@ bool OctreeAccel::occluded_counting(const Rayf& ray_in, OctreeRayCounters& count
     return trace<true, true>(ray, hit, &counters);
 }
 
+bool OctreeAccel::count_traversal(std::span<const Rayf> rays, bool any_hit, std::span<Hitf> hits,
+                               TraversalCounts& counts) const {
+    OctreeRayCounters c;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        Rayf ray = rays[i];
+        Hitf hit;
+        const bool found = any_hit ? trace<true, true>(ray, hit, &c) : trace<false, true>(ray, hit, &c);
+        hits[i] = found ? hit : Hitf{};
+    }
+    counts.nodes += c.nodes_visited;
+    counts.prims += c.prim_tests;
+    return true;
+}
+
 bool OctreeAccel::supports_packet(int width) const {
     return width == 1 || (width == 4 && kWidthCompiled<4>) || (width == 8 && kWidthCompiled<8>) ||
            (width == 16 && kWidthCompiled<16>);
