@@ -4,13 +4,12 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
-#include <array>
-#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
-#include <sstream>
+#include <iterator>
 
 #include "accel/accel.h"
 
@@ -19,26 +18,26 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-    int status;
-    std::string output;  // stdout and stderr together
-};
-
-Result run_bench(const std::string& args) {
-    const std::string cmd = std::string(RAYPACK_CLI) + " bench " + args + " 2>&1";
-    FILE* pipe = popen(cmd.c_str(), "r");
-    std::string out;
-    std::array<char, 4096> buf;
-    std::size_t n;
-    while ((n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0) out.append(buf.data(), n);
-    const int status = pclose(pipe);
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
-
 fs::path temp_dir() {
     const fs::path d = fs::temp_directory_path() / "raypack_test_bench_cli";
     fs::create_directories(d);
     return d;
+}
+
+/// Exit status of `raypack bench ARGS` and what it printed (both streams).
+struct BenchRun {
+    int status = -1;
+    std::string output;
+};
+
+BenchRun run_bench(const std::string& args) {
+    const fs::path log = temp_dir() / "bench.log";
+    const int raw = std::system((std::string(RAYPACK_CLI) + " bench " + args + " >" + log.string() + " 2>&1").c_str());
+    BenchRun run;
+    run.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    std::ifstream in(log);
+    run.output.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    return run;
 }
 
 std::string first_line(const fs::path& p) {
@@ -57,7 +56,7 @@ TEST(BenchCli, QuickRunValidatesEveryStructureWidthAndRayKind) {
     const fs::path json = temp_dir() / "quick.json", csv = temp_dir() / "quick.csv";
     fs::remove(json);
     fs::remove(csv);
-    const Result r = run_bench("--quick --json " + json.string() + " --csv " + csv.string());
+    const BenchRun r = run_bench("--quick --json " + json.string() + " --csv " + csv.string());
     ASSERT_EQ(r.status, 0) << r.output;
     EXPECT_NE(r.output.find("elapsed"), std::string::npos) << "progress lines on stderr";
 
@@ -98,20 +97,20 @@ TEST(BenchCli, QuickRunValidatesEveryStructureWidthAndRayKind) {
 TEST(BenchCli, BadFlagsAreUsageErrors) {
     for (const char* args : {"--accel nosuch", "--packet 3", "--rays camera,sideways", "--repeat 0", "--threads x",
                              "--res 10", "--bogus", "--rays camera --rays-file x.rays"}) {
-        const Result r = run_bench(args);
+        const BenchRun r = run_bench(args);
         EXPECT_EQ(r.status, 2) << args << ": " << r.output;
         EXPECT_NE(r.output.find("raypack bench"), std::string::npos) << args << ": " << r.output;
     }
 }
 
 TEST(BenchCli, MissingFilesNameTheFile) {
-    const Result scene = run_bench("/nonexistent/scene.nff --accel bvh2 --rays camera --res 8 8");
+    const BenchRun scene = run_bench("/nonexistent/scene.nff --accel bvh2 --rays camera --res 8 8");
     EXPECT_EQ(scene.status, 1);
     EXPECT_NE(scene.output.find("/nonexistent/scene.nff"), std::string::npos) << scene.output;
-    const Result rays = run_bench("gen:balls:1 --rays-file /nonexistent/x.rays --accel bvh2");
+    const BenchRun rays = run_bench("gen:balls:1 --rays-file /nonexistent/x.rays --accel bvh2");
     EXPECT_EQ(rays.status, 1);
     EXPECT_NE(rays.output.find("/nonexistent/x.rays"), std::string::npos) << rays.output;
-    const Result out = run_bench("gen:balls:1 --accel bvh2 --rays camera --res 8 8 --repeat 1 --json /nonexistent/dir/x.json");
+    const BenchRun out = run_bench("gen:balls:1 --accel bvh2 --rays camera --res 8 8 --repeat 1 --json /nonexistent/dir/x.json");
     EXPECT_EQ(out.status, 1);
     EXPECT_NE(out.output.find("/nonexistent/dir/x.json"), std::string::npos) << out.output;
 }
@@ -121,7 +120,7 @@ TEST(BenchCli, RaysFileIsTracedAndValidated) {
     const std::string make = std::string(RAYPACK_CLI) + " rays gen:balls:2 --kind diffuse --res 32 32 -o " + rays.string();
     ASSERT_EQ(std::system(make.c_str()), 0);
     const fs::path json = temp_dir() / "file.json";
-    const Result r = run_bench("gen:balls:2 --rays-file " + rays.string() + " --accel bvh2,grid --repeat 1 --json " +
+    const BenchRun r = run_bench("gen:balls:2 --rays-file " + rays.string() + " --accel bvh2,grid --repeat 1 --json " +
                                json.string());
     ASSERT_EQ(r.status, 0) << r.output;
     std::ifstream in(json);

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "accel/count_each_ray.h"
 #include "accel/grid/dda.h"
 #include "accel/grid/grid_build.h"
 #include "accel/grid/grid_packet.h"
@@ -132,17 +133,8 @@ bool GridAccel::occluded_counting(const Rayf& ray_in, GridRayCounters& counters)
 }
 
 bool GridAccel::count_traversal(std::span<const Rayf> rays, bool any_hit, std::span<Hitf> hits,
-                               TraversalCounts& counts) const {
-    GridRayCounters c;
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-        Rayf ray = rays[i];
-        Hitf hit;
-        const bool found = any_hit ? trace<true, true>(ray, hit, &c) : trace<false, true>(ray, hit, &c);
-        hits[i] = found ? hit : Hitf{};
-    }
-    counts.nodes += c.cells_visited;
-    counts.prims += c.prim_tests;
-    return true;
+                                TraversalCounts& counts) const {
+    return count_each_ray(*this, rays, any_hit, hits, counts, &GridRayCounters::cells_visited);
 }
 
 bool GridAccel::supports_packet(int width) const {

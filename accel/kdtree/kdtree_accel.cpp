@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "accel/count_each_ray.h"
 #include "accel/kdtree/kdtree_build.h"
 #include "accel/kdtree/kdtree_packet.h"
 #include "accel/kdtree/kdtree_ray_interval.h"
@@ -159,17 +160,8 @@ bool KdTreeAccel::occluded_counting(const Rayf& ray_in, KdRayCounters& counters)
 }
 
 bool KdTreeAccel::count_traversal(std::span<const Rayf> rays, bool any_hit, std::span<Hitf> hits,
-                               TraversalCounts& counts) const {
-    KdRayCounters c;
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-        Rayf ray = rays[i];
-        Hitf hit;
-        const bool found = any_hit ? trace<true, true>(ray, hit, &c) : trace<false, true>(ray, hit, &c);
-        hits[i] = found ? hit : Hitf{};
-    }
-    counts.nodes += c.nodes_visited;
-    counts.prims += c.prim_tests;
-    return true;
+                                  TraversalCounts& counts) const {
+    return count_each_ray(*this, rays, any_hit, hits, counts, &KdRayCounters::nodes_visited);
 }
 
 bool KdTreeAccel::supports_packet(int width) const {

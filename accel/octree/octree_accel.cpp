@@ -6,6 +6,7 @@
 #include <cmath>
 #include <vector>
 
+#include "accel/count_each_ray.h"
 #include "accel/octree/octree_build.h"
 #include "accel/octree/octree_packet.h"
 #include "accel/octree/revelles.h"
@@ -173,17 +174,8 @@ bool OctreeAccel::occluded_counting(const Rayf& ray_in, OctreeRayCounters& count
 }
 
 bool OctreeAccel::count_traversal(std::span<const Rayf> rays, bool any_hit, std::span<Hitf> hits,
-                               TraversalCounts& counts) const {
-    OctreeRayCounters c;
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-        Rayf ray = rays[i];
-        Hitf hit;
-        const bool found = any_hit ? trace<true, true>(ray, hit, &c) : trace<false, true>(ray, hit, &c);
-        hits[i] = found ? hit : Hitf{};
-    }
-    counts.nodes += c.nodes_visited;
-    counts.prims += c.prim_tests;
-    return true;
+                                  TraversalCounts& counts) const {
+    return count_each_ray(*this, rays, any_hit, hits, counts, &OctreeRayCounters::nodes_visited);
 }
 
 bool OctreeAccel::supports_packet(int width) const {
