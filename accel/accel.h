@@ -26,6 +26,14 @@ struct AccelStats {
     std::size_t empty_leaves = 0;   ///< empty leaves, or empty cells for the grid
 };
 
+/// Work of tracing rays one at a time: nodes (or grid cells) entered, inner
+/// and leaf, and ray-primitive tests run. The figures papers compare
+/// structures by, independent of the machine.
+struct TraversalCounts {
+    std::uint64_t nodes = 0;
+    std::uint64_t prims = 0;
+};
+
 struct AccelConfig {
     std::string kind = "bvh2";  ///< bvh2 | brute
     KernelChoice kernels;
@@ -56,6 +64,15 @@ public:
     virtual void occluded_packets(int width, std::span<const Rayf> rays, std::span<std::uint8_t> occluded_out) const {
         (void)width;
         occluded(rays, occluded_out);
+    }
+
+    /// Traces each ray alone, in the order of the single-ray path, adding its
+    /// work to `counts`; hits[i] gets the answer (any_hit: found() = occluded).
+    /// Never on a timed path. False where the structure cannot count (Embree).
+    virtual bool count_traversal(std::span<const Rayf> rays, bool any_hit, std::span<Hitf> hits,
+                                 TraversalCounts& counts) const {
+        (void)rays, (void)any_hit, (void)hits, (void)counts;
+        return false;
     }
 
     Hitf intersect1(const Rayf& ray) const {

@@ -1,4 +1,4 @@
-// raypack rays SCENE --kind camera|shadow [--res W H] -o FILE.rays
+// raypack rays SCENE --kind camera|shadow|diffuse [--res W H] [--seed S] -o FILE.rays
 // Writes the ray sets the benchmarks and the Embree comparison trace.
 #include <cstdio>
 
@@ -11,12 +11,13 @@
 namespace raypack::app {
 
 int run_rays(const Args& args) {
-    const ParsedArgs p(args, {{"--kind", "", 1}, {"--res", "", 2}, {"--output", "-o", 1}}, 1);
+    const ParsedArgs p(args, {{"--kind", "", 1}, {"--res", "", 2}, {"--output", "-o", 1}, {"--seed", "", 1}}, 1);
     if (p.help() || p.positional().empty()) {
         std::printf(
-            "usage: raypack rays SCENE --kind camera|shadow [--res W H] -o FILE.rays\n"
+            "usage: raypack rays SCENE --kind camera|shadow|diffuse [--res W H] [--seed S] -o FILE.rays\n"
             "  camera   one closest-hit ray through each pixel centre (kind 0)\n"
-            "  shadow   any-hit rays from each camera hit to the first light (kind 1)\n");
+            "  shadow   any-hit rays from each camera hit to the first light (kind 1)\n"
+            "  diffuse  a cosine-weighted bounce from each camera hit (kind 0); --seed S (default 1)\n");
         if (!p.help()) throw UsageError("missing SCENE");
         return 0;
     }
@@ -32,8 +33,10 @@ int run_rays(const Args& args) {
     } else if (kind == "shadow") {
         rays = shadow_ray_set(scene, w, h);
         file_kind = RayKind::AnyHit;
+    } else if (kind == "diffuse") {
+        rays = diffuse_ray_set(scene, w, h, std::uint64_t(p.integer("--seed", 1, 0, 1LL << 62)));
     } else {
-        throw UsageError("--kind: expected camera or shadow, got '" + kind + "'");
+        throw UsageError("--kind: expected camera, shadow or diffuse, got '" + kind + "'");
     }
     write_rays(p.text("--output"), file_kind, rays);
     std::printf("wrote %zu %s rays to %s\n", rays.size(), kind.c_str(), p.text("--output").c_str());

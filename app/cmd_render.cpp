@@ -1,10 +1,11 @@
-// raypack render SCENE [-o out.png] [--res W H] [--depth D] [--threads T]
+// raypack render SCENE [-o out.png] [--res W H] [--depth D] [--threads T] [--aov cost]
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 
 #include "app/accel_options.h"
 #include "app/commands.h"
+#include "render/cost_map.h"
 #include "render/whitted.h"
 #include "scene/load.h"
 
@@ -25,19 +26,39 @@ std::string default_output(const std::string& spec) {
     return std::filesystem::path(spec).stem().string() + ".png";
 }
 
+/// --aov cost: the heat map, and its scale on stdout.
+int render_cost(const Scene& scene, const Accel& accel, int width, int height, const std::string& output) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const CostMap map = primary_ray_cost(scene, accel, width, height);
+    write_image(output, cost_heat_map(map));
+    double sum = 0;
+    for (std::uint32_t c : map.cost) sum += c;
+    std::printf("raypack render --aov cost: %s, %s, %dx%d in %.1f ms\n", scene.source.c_str(),
+                accel.stats().name.c_str(), width, height, ms_since(t0));
+    std::printf("  scale      nodes + primitive tests per camera ray: %u (dark blue) .. %u (yellow), viridis, "
+                "linear; mean %.1f\n",
+                map.min, map.max, map.cost.empty() ? 0.0 : sum / double(map.cost.size()));
+    std::printf("  image      %s (%dx%d, legend in the bottom %d rows)\n", std::filesystem::absolute(output).string().c_str(),
+                width, height + cost_legend_height(width), cost_legend_height(width));
+    return 0;
+}
+
 }  // namespace
 
 int run_render(const Args& args) {
     auto spec = accel_option_specs();
-    spec.insert(spec.end(), {{"--output", "-o", 1}, {"--res", "", 2}, {"--depth", "", 1}, {"--threads", "", 1}});
+    spec.insert(spec.end(), {{"--output", "-o", 1}, {"--res", "", 2}, {"--depth", "", 1}, {"--threads", "", 1},
+                             {"--aov", "", 1}});
     const ParsedArgs p(args, spec, 1);
     if (p.help() || p.positional().empty()) {
         std::printf(
-            "usage: raypack render SCENE [-o out.png] [--res W H] [--depth D] [--threads T]\n"
+            "usage: raypack render SCENE [-o out.png] [--res W H] [--depth D] [--threads T] [--aov cost]\n"
             "  -o FILE       output image; format from the extension (png, exr, ...)\n"
             "  --res W H     resolution (default: the scene's, 512x512 for SPD)\n"
             "  --depth D     maximum ray depth, eye ray = 1 (default 5, the SPD protocol)\n"
-            "  --threads T   worker threads (default: all cores)\n%s",
+            "  --threads T   worker threads (default: all cores)\n"
+            "  --aov cost    instead of shading: the traversal cost (nodes + primitive tests) of each\n"
+            "                pixel's camera ray as a viridis heat map with its scale below the picture\n%s",
             accel_options_help().c_str());
         if (!p.help()) throw UsageError("missing SCENE");
         return 0;
@@ -48,6 +69,8 @@ int run_render(const Args& args) {
     options.max_depth = int(p.integer("--depth", 5, 1, 64));
     const ThreadLimit limit(int(p.integer("--threads", 0, 1, 1024)));
     const std::string output = p.has("--output") ? p.text("--output") : default_output(scene_spec);
+    const std::string aov = p.text("--aov");
+    if (p.has("--aov") && aov != "cost") throw UsageError("--aov: expected cost, got '" + aov + "'");
 
     auto t0 = std::chrono::steady_clock::now();
     const Scene scene = load_scene(scene_spec);
@@ -58,6 +81,7 @@ int run_render(const Args& args) {
         throw UsageError("--res: image of more than 2^28 pixels");
 
     const auto accel = build_accel(scene, config);
+    if (aov == "cost") return render_cost(scene, *accel, options.width, options.height, output);
     options.packet = packet_width_from(p, *accel);
     Image image;
     const RenderStats stats = render_whitted(scene, *accel, options, image);

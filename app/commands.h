@@ -46,5 +46,6 @@ int run_trace(const Args& args);
 int run_info(const Args& args);
 int run_gen(const Args& args);
 int run_rays(const Args& args);
+int run_bench(const Args& args);
 
 }  // namespace raypack::app

@@ -17,7 +17,8 @@ void print_usage(std::FILE* out) {
         "  trace  SCENE --rays FILE.rays [-o FILE.hits] [--threads T] [--repeat R] [--json]\n"
         "  info   SCENE\n"
         "  gen    NAME --size S -o FILE.nff\n"
-        "  rays   SCENE --kind camera|shadow [--res W H] -o FILE.rays\n"
+        "  rays   SCENE --kind camera|shadow|diffuse [--res W H] -o FILE.rays\n"
+        "  bench  [SCENE...] [--accel LIST] [--packet LIST] [--rays KINDS] [--quick] [--json F] [--csv F]\n"
         "\n"
         "SCENE is an .nff or .obj file, or gen:NAME:SIZE for a generated SPD scene.\n"
         "Run 'raypack COMMAND --help' for a command's options.\n",
@@ -43,6 +44,7 @@ int main(int argc, char** argv) {
         if (command == "info") return raypack::app::run_info(args);
         if (command == "gen") return raypack::app::run_gen(args);
         if (command == "rays") return raypack::app::run_rays(args);
+        if (command == "bench") return raypack::app::run_bench(args);
     } catch (const raypack::app::UsageError& e) {
         std::fprintf(stderr, "raypack %s: %s\n", command.c_str(), e.what());
         return 2;

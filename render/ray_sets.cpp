@@ -4,12 +4,65 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "accel/accel.h"
 #include "render/camera_rays.h"
 #include "render/surface.h"
 
 namespace raypack {
+namespace {
+
+/// The closest hit of every camera ray, found with the reference BVH2.
+std::vector<Hitf> camera_hits(const Scene& scene, const std::vector<Rayf>& camera) {
+    const auto accel = build_accel(scene, AccelConfig{});
+    std::vector<Hitf> hits(camera.size());
+    tbb::parallel_for(std::size_t(0), camera.size(), std::size_t(1024), [&](std::size_t b) {
+        const std::size_t n = std::min<std::size_t>(1024, camera.size() - b);
+        accel->intersect({camera.data() + b, n}, {hits.data() + b, n});
+    });
+    return hits;
+}
+
+/// The hit point moved off the surface, to the side the ray came from, by an
+/// amount relative to its magnitude so that the new ray does not hit the
+/// same surface again.
+Vec3f offset_origin(const Surface& s, const Vec3f& incoming) {
+    const Vec3f n = dot(s.geometric_normal, incoming) < 0 ? s.geometric_normal : -s.geometric_normal;
+    const float scale = std::max({std::fabs(s.point.x), std::fabs(s.point.y), std::fabs(s.point.z), 1e-3f});
+    return s.point + n * (1e-4f * scale);
+}
+
+/// SplitMix64 (Steele, Lea, Flood, OOPSLA 2014): a counter-based generator,
+/// so each pixel's numbers depend on (seed, pixel) alone.
+std::uint64_t splitmix64(std::uint64_t& state) {
+    std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+float uniform01(std::uint64_t& state) { return float(splitmix64(state) >> 40) * 0x1.0p-24f; }
+
+/// Malley's method: uniform on the unit disk (polar mapping), lifted to the
+/// hemisphere about +z; the density is cos(theta) / pi.
+Vec3f cosine_hemisphere(float u1, float u2) {
+    const float r = std::sqrt(u1), phi = 2.0f * std::numbers::pi_v<float> * u2;
+    const float x = r * std::cos(phi), y = r * std::sin(phi);
+    return {x, y, std::sqrt(std::max(0.0f, 1.0f - x * x - y * y))};
+}
+
+/// An orthonormal frame about unit n (Duff et al., "Building an Orthonormal
+/// Basis, Revisited", JCGT 2017), applied to a local direction.
+Vec3f to_world(const Vec3f& n, const Vec3f& local) {
+    const float sign = std::copysign(1.0f, n.z);
+    const float a = -1.0f / (sign + n.z), b = n.x * n.y * a;
+    const Vec3f t(1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x);
+    const Vec3f bt(b, sign + n.y * n.y * a, -n.y);
+    return t * local.x + bt * local.y + n * local.z;
+}
+
+}  // namespace
 
 std::vector<Rayf> camera_ray_set(const Scene& scene, int width, int height) {
     const CameraFrame frame = make_camera_frame(scene.camera, width, height);
@@ -23,24 +76,35 @@ std::vector<Rayf> camera_ray_set(const Scene& scene, int width, int height) {
 std::vector<Rayf> shadow_ray_set(const Scene& scene, int width, int height) {
     if (scene.lights.empty()) return {};
     const std::vector<Rayf> camera = camera_ray_set(scene, width, height);
-    const auto accel = build_accel(scene, AccelConfig{});
-    std::vector<Hitf> hits(camera.size());
-    tbb::parallel_for(std::size_t(0), camera.size(), std::size_t(1024), [&](std::size_t b) {
-        const std::size_t n = std::min<std::size_t>(1024, camera.size() - b);
-        accel->intersect({camera.data() + b, n}, {hits.data() + b, n});
-    });
+    const std::vector<Hitf> hits = camera_hits(scene, camera);
     const Vec3f light = scene.lights.front().position;
     std::vector<Rayf> rays;
     for (std::size_t i = 0; i < camera.size(); ++i) {
         if (!hits[i].found()) continue;
-        const Surface s = surface_at(scene, camera[i], hits[i]);
-        const Vec3f n = dot(s.geometric_normal, camera[i].dir) < 0 ? s.geometric_normal : -s.geometric_normal;
-        const float scale = std::max({std::fabs(s.point.x), std::fabs(s.point.y), std::fabs(s.point.z), 1e-3f});
         Rayf r;
-        r.org = s.point + n * (1e-4f * scale);
+        r.org = offset_origin(surface_at(scene, camera[i], hits[i]), camera[i].dir);
         r.dir = light - r.org;
         r.tnear = 0;
         r.tfar = 1.0f - 1e-6f;
+        rays.push_back(r);
+    }
+    return rays;
+}
+
+std::vector<Rayf> diffuse_ray_set(const Scene& scene, int width, int height, std::uint64_t seed) {
+    const std::vector<Rayf> camera = camera_ray_set(scene, width, height);
+    const std::vector<Hitf> hits = camera_hits(scene, camera);
+    std::vector<Rayf> rays;
+    for (std::size_t i = 0; i < camera.size(); ++i) {
+        if (!hits[i].found()) continue;
+        const Surface s = surface_at(scene, camera[i], hits[i]);
+        const Vec3f n = dot(s.shading_normal, camera[i].dir) < 0 ? s.shading_normal : -s.shading_normal;
+        std::uint64_t state = seed * 0x9E3779B97F4A7C15ull ^ std::uint64_t(i);
+        splitmix64(state);  // decorrelate neighbouring pixels before the first draw
+        const float u1 = uniform01(state), u2 = uniform01(state);
+        Rayf r;
+        r.org = offset_origin(s, camera[i].dir);
+        r.dir = to_world(n, cosine_hemisphere(u1, u2));
         rays.push_back(r);
     }
     return rays;

@@ -1,5 +1,6 @@
 #pragma once
 // The standard ray sets traced by benchmarks and comparisons.
+#include <cstdint>
 #include <vector>
 
 #include "kernels/ray.h"
@@ -14,5 +15,13 @@ std::vector<Rayf> camera_ray_set(const Scene& scene, int width, int height);
 /// light, offset off the surface; tfar stops just short of the light. Empty
 /// when the scene has no light.
 std::vector<Rayf> shadow_ray_set(const Scene& scene, int width, int height);
+
+/// From each camera-ray hit, one diffuse bounce: a cosine-weighted unit
+/// direction about the shading normal turned toward the incoming ray (Malley's
+/// method: a uniform point on the unit disk lifted onto the hemisphere, Pharr,
+/// Jakob, Humphreys, PBR 4th ed., 13.6.3). Pixel i draws from a generator
+/// seeded by (seed, i), so the set is the same every run and for any thread
+/// count. Origins are offset off the surface as for shadow rays; tfar = inf.
+std::vector<Rayf> diffuse_ray_set(const Scene& scene, int width, int height, std::uint64_t seed = 1);
 
 }  // namespace raypack

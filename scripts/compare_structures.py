@@ -1,11 +1,12 @@
 #!/usr/bin/env python3
 """Every acceleration structure against the BVH2 on the same rays, in one run.
 
-For each scene: camera rays at RES x RES (raypack rays), then raypack trace
-with one thread for every structure and packet width, median of REPEAT timed
-passes after a warm-up. Prints a Markdown table of Mrays/s and ratios to the
-first structure listed (the BVH2 by default) at the same width. Until `raypack bench` exists (issue 6), this is how
-the README's structure table is made.
+One `raypack bench` run (camera rays at RES x RES, one thread, every
+structure and packet width, each validated against the oracle, median of
+REPEAT timed passes after a warm-up), printed as a Markdown table of Mrays/s
+and ratios to the first structure listed (the BVH2 by default) at the same
+width; "-" where a structure has no packets of that width. This is how the
+README's structure table is made.
 
 usage: scripts/compare_structures.py [--res 1024] [--repeat 5] [SCENE ...]
 """
@@ -20,11 +21,16 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 RAYPACK = os.path.join(ROOT, os.environ.get("RAYPACK_BUILD_DIR", "build"), "raypack")
 
 
-def trace(scene, rays, accel, packet, repeat):
-    out = subprocess.run([RAYPACK, "trace", scene, "--rays", rays, "--accel", accel, "--packet", str(packet),
-                          "--threads", "1", "--repeat", str(repeat), "--json"],
-                         check=True, capture_output=True, text=True).stdout
-    return json.loads(out)
+def bench(scenes, accels, packets, res, repeat):
+    """Rows of raypack bench --json, keyed by (scene as given, accel, packet)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        out = os.path.join(tmp, "bench.json")
+        subprocess.run([RAYPACK, "bench", *scenes, "--accel", ",".join(accels),
+                        "--packet", ",".join(str(k) for k in packets), "--rays", "camera", "--threads", "1",
+                        "--res", str(res), str(res), "--repeat", str(repeat), "--json", out],
+                       check=True, stdout=subprocess.DEVNULL)
+        with open(out) as f:
+            return {(r["scene_file"], r["accel"], r["packet"]): r for r in json.load(f)}
 
 
 def main():
@@ -41,17 +47,15 @@ def main():
     print("| scene | K | " + " | ".join(f"{a} Mrays/s" for a in accels) + " | " +
           " | ".join(f"{a}/{accels[0]}" for a in accels[1:]) + " |")
     print("|---" * (2 + 2 * len(accels) - 1) + "|")
-    with tempfile.TemporaryDirectory() as tmp:
-        for scene in args.scenes:
-            path = scene if scene.startswith("gen:") else os.path.join(ROOT, scene)
-            rays = os.path.join(tmp, "camera.rays")
-            subprocess.run([RAYPACK, "rays", path, "--kind", "camera", "--res", str(args.res), str(args.res),
-                            "-o", rays], check=True, capture_output=True)
-            for k in packets:
-                rate = {a: trace(path, rays, a, k, args.repeat)["mrays_per_s_median"] for a in accels}
-                base = rate[accels[0]]
-                print(f"| {scene} | {k} | " + " | ".join(f"{rate[a]:.2f}" for a in accels) + " | " +
-                      " | ".join(f"{rate[a] / base:.2f}" for a in accels[1:]) + " |", flush=True)
+    paths = [scene if scene.startswith("gen:") else os.path.join(ROOT, scene) for scene in args.scenes]
+    rows = bench(paths, accels, packets, args.res, args.repeat)
+    for scene, path in zip(args.scenes, paths):
+        for k in packets:
+            rate = {a: rows[(path, a, k)]["mrays_per_s_median"] if (path, a, k) in rows else None for a in accels}
+            base = rate[accels[0]]
+            cells = [f"{rate[a]:.2f}" if rate[a] else "-" for a in accels]
+            ratios = [f"{rate[a] / base:.2f}" if rate[a] and base else "-" for a in accels[1:]]
+            print(f"| {scene} | {k} | " + " | ".join(cells) + " | " + " | ".join(ratios) + " |", flush=True)
     return 0
 
 

@@ -31,6 +31,22 @@ void BruteForce::occluded(std::span<const Rayf> rays, std::span<std::uint8_t> oc
     }
 }
 
+bool BruteForce::count_traversal(std::span<const Rayf> rays, bool any_hit, std::span<Hitf> hits,
+                                 TraversalCounts& counts) const {
+    const PrimitiveIntersector<float> isect{scene_, kernels_};
+    const auto n = std::uint32_t(scene_->primitive_count());
+    for (std::size_t r = 0; r < rays.size(); ++r) {
+        Rayf ray = rays[r];
+        Hitf hit;
+        bool found = false;
+        std::uint32_t p = 0;
+        while (p < n && !(any_hit && found)) found |= isect.intersect(p++, ray, hit);
+        counts.prims += p;
+        hits[r] = found ? hit : Hitf{};
+    }
+    return true;
+}
+
 Hit<double> BruteForce::intersect_double(const Ray<double>& ray_in) const {
     const PrimitiveIntersector<double> isect{scene_, kernels_};
     Ray<double> ray = ray_in;

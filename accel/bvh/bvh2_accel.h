@@ -14,6 +14,7 @@ public:
     bool supports_packet(int width) const override;
     void intersect_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const override;
     void occluded_packets(int width, std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override;
+    bool count_traversal(std::span<const Rayf> rays, bool any_hit, std::span<Hitf> hits, TraversalCounts& counts) const override;  // bvh2_counting.cpp
     const Bvh2& bvh() const { return bvh_; }
 
 private:

@@ -18,6 +18,7 @@ public:
     void intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const override;
     void occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override;
     const AccelStats& stats() const override { return stats_; }
+    bool count_traversal(std::span<const Rayf> rays, bool any_hit, std::span<Hitf> hits, TraversalCounts& counts) const override;  // wide_counting.cpp
     const WideBvh<N, M>& bvh() const { return bvh_; }
 
     /// The collapse settings a config implies (N-wide node and M-wide block costs).

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "accel/count_each_ray.h"
 #include "accel/grid/dda.h"
 #include "accel/grid/grid_build.h"
 #include "accel/grid/grid_packet.h"
@@ -129,6 +130,11 @@ bool GridAccel::occluded_counting(const Rayf& ray_in, GridRayCounters& counters)
     Rayf ray = ray_in;
     Hitf hit;
     return trace<true, true>(ray, hit, &counters);
+}
+
+bool GridAccel::count_traversal(std::span<const Rayf> rays, bool any_hit, std::span<Hitf> hits,
+                                TraversalCounts& counts) const {
+    return count_each_ray(*this, rays, any_hit, hits, counts, &GridRayCounters::cells_visited);
 }
 
 bool GridAccel::supports_packet(int width) const {

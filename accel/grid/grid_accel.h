@@ -34,6 +34,8 @@ public:
     /// The same queries, adding each ray's work to `counters` (slower; tests and analysis).
     Hitf intersect_counting(const Rayf& ray, GridRayCounters& counters) const;
     bool occluded_counting(const Rayf& ray, GridRayCounters& counters) const;
+    bool count_traversal(std::span<const Rayf> rays, bool any_hit, std::span<Hitf> hits,
+                         TraversalCounts& counts) const override;
 
     const Grid& grid() const { return grid_; }
     std::array<int, 3> resolution() const { return grid_.geometry.res; }

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "accel/count_each_ray.h"
 #include "accel/kdtree/kdtree_build.h"
 #include "accel/kdtree/kdtree_packet.h"
 #include "accel/kdtree/kdtree_ray_interval.h"
@@ -156,6 +157,11 @@ bool KdTreeAccel::occluded_counting(const Rayf& ray_in, KdRayCounters& counters)
     Rayf ray = ray_in;
     Hitf hit;
     return trace<true, true>(ray, hit, &counters);
+}
+
+bool KdTreeAccel::count_traversal(std::span<const Rayf> rays, bool any_hit, std::span<Hitf> hits,
+                                  TraversalCounts& counts) const {
+    return count_each_ray(*this, rays, any_hit, hits, counts, &KdRayCounters::nodes_visited);
 }
 
 bool KdTreeAccel::supports_packet(int width) const {

@@ -30,6 +30,8 @@ public:
     /// The same queries, adding each ray's work to `counters` (slower; tests and analysis).
     Hitf intersect_counting(const Rayf& ray, KdRayCounters& counters) const;
     bool occluded_counting(const Rayf& ray, KdRayCounters& counters) const;
+    bool count_traversal(std::span<const Rayf> rays, bool any_hit, std::span<Hitf> hits,
+                         TraversalCounts& counts) const override;
 
     const KdTree& tree() const { return tree_; }
     /// References per primitive: how often the average primitive is stored.

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <vector>
 
+#include "accel/count_each_ray.h"
 #include "accel/octree/octree_build.h"
 #include "accel/octree/octree_packet.h"
 #include "accel/octree/revelles.h"
@@ -170,6 +171,11 @@ bool OctreeAccel::occluded_counting(const Rayf& ray_in, OctreeRayCounters& count
     Rayf ray = ray_in;
     Hitf hit;
     return trace<true, true>(ray, hit, &counters);
+}
+
+bool OctreeAccel::count_traversal(std::span<const Rayf> rays, bool any_hit, std::span<Hitf> hits,
+                                  TraversalCounts& counts) const {
+    return count_each_ray(*this, rays, any_hit, hits, counts, &OctreeRayCounters::nodes_visited);
 }
 
 bool OctreeAccel::supports_packet(int width) const {

@@ -30,6 +30,8 @@ public:
     /// The same queries, adding each ray's work to `counters` (slower; tests and analysis).
     Hitf intersect_counting(const Rayf& ray, OctreeRayCounters& counters) const;
     bool occluded_counting(const Rayf& ray, OctreeRayCounters& counters) const;
+    bool count_traversal(std::span<const Rayf> rays, bool any_hit, std::span<Hitf> hits,
+                         TraversalCounts& counts) const override;
 
     const Octree& octree() const { return tree_; }
     std::size_t reference_count() const { return tree_.refs.size(); }

@@ -1,0 +1,113 @@
+#include "app/bench_report.h"
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
+
+#include "scene/atomic_file.h"
+
+namespace raypack::app {
+namespace {
+
+std::string format_optional(const std::optional<double>& v, const char* format) {
+    if (!v) return "-";
+    char buf[32];
+    std::snprintf(buf, sizeof buf, format, *v);
+    return buf;
+}
+
+std::string format_bytes(std::size_t bytes) {
+    char buf[32];
+    if (bytes >= (std::size_t(1) << 20)) std::snprintf(buf, sizeof buf, "%.1f MiB", double(bytes) / double(1 << 20));
+    else std::snprintf(buf, sizeof buf, "%.1f KiB", double(bytes) / 1024.0);
+    return buf;
+}
+
+/// Column order of the JSON objects and the CSV file.
+nlohmann::ordered_json to_json(const BenchRow& r) {
+    nlohmann::ordered_json j;
+    j["scene"] = r.scene;
+    j["scene_file"] = r.scene_file;
+    j["accel"] = r.accel;
+    j["builder"] = r.builder;
+    j["packet"] = r.packet;
+    j["rays"] = r.rays;
+    j["query"] = r.any_hit ? "any" : "closest";
+    j["ray_count"] = r.ray_count;
+    j["threads"] = r.threads;
+    j["repeat"] = r.repeat;
+    j["build_ms"] = r.build_ms;
+    j["memory_bytes"] = r.memory_bytes;
+    j["sah_cost"] = r.sah_cost;
+    j["mrays_per_s_median"] = r.mrays_per_s_median;
+    j["mrays_per_s_min"] = r.mrays_per_s_min;
+    j["mrays_per_s_max"] = r.mrays_per_s_max;
+    j["trace_ms_median"] = r.trace_ms_median;
+    j["nodes_per_ray"] = r.nodes_per_ray ? nlohmann::ordered_json(*r.nodes_per_ray) : nlohmann::ordered_json();
+    j["prims_per_ray"] = r.prims_per_ray ? nlohmann::ordered_json(*r.prims_per_ray) : nlohmann::ordered_json();
+    j["hits"] = r.hits;
+    j["validated_rays"] = r.validated_rays;
+    j["validated"] = r.validated;
+    return j;
+}
+
+void write_text(const std::string& path, const std::string& text) {
+    write_atomically(path, [&](const std::string& tmp) {
+        std::ofstream out(tmp, std::ios::binary);
+        out << text;
+        out.close();
+        if (!out) throw std::runtime_error("cannot write " + path);
+    });
+}
+
+std::string csv_field(const nlohmann::ordered_json& v) {
+    if (v.is_null()) return "";
+    if (v.is_string()) return v.get<std::string>();  // names hold no commas or quotes
+    return v.dump();
+}
+
+}  // namespace
+
+void print_bench_header(std::FILE* out) {
+    std::fprintf(out, "%-8s %-7s %2s %-8s %3s %9s %10s %9s %9s %19s %9s %9s\n", "scene", "accel", "K", "rays", "thr",
+                 "build ms", "memory", "SAH cost", "Mrays/s", "(min - max)", "nodes/ray", "prims/ray");
+}
+
+void print_bench_row(std::FILE* out, const BenchRow& r) {
+    char spread[32];
+    std::snprintf(spread, sizeof spread, "(%.2f - %.2f)", r.mrays_per_s_min, r.mrays_per_s_max);
+    std::fprintf(out, "%-8s %-7s %2d %-8s %3d %9.1f %10s %9s %9.2f %19s %9s %9s\n", r.scene.c_str(), r.accel.c_str(),
+                 r.packet, r.rays.c_str(), r.threads, r.build_ms, format_bytes(r.memory_bytes).c_str(),
+                 r.sah_cost > 0 ? format_optional(r.sah_cost, "%.1f").c_str() : "-", r.mrays_per_s_median, spread,
+                 format_optional(r.nodes_per_ray, "%.1f").c_str(), format_optional(r.prims_per_ray, "%.1f").c_str());
+}
+
+void write_bench_json(const std::string& path, const std::vector<BenchRow>& rows) {
+    nlohmann::ordered_json array = nlohmann::ordered_json::array();
+    for (const BenchRow& r : rows) array.push_back(to_json(r));
+    write_text(path, array.dump(2) + "\n");
+}
+
+void write_bench_csv(const std::string& path, const std::vector<BenchRow>& rows) {
+    std::ostringstream out;
+    bool header = true;
+    const nlohmann::ordered_json columns = to_json(BenchRow{});  // items() must not outlive its object
+    for (const auto& key_value : columns.items()) {
+        out << (header ? "" : ",") << key_value.key();
+        header = false;
+    }
+    out << "\n";
+    for (const BenchRow& r : rows) {
+        bool first = true;
+        const nlohmann::ordered_json values = to_json(r);
+        for (const auto& key_value : values.items()) {
+            out << (first ? "" : ",") << csv_field(key_value.value());
+            first = false;
+        }
+        out << "\n";
+    }
+    write_text(path, out.str());
+}
+
+}  // namespace raypack::app

@@ -1,0 +1,133 @@
+// raypack bench: the CI run (--quick) must finish, validate every row and
+// write JSON and CSV with the documented columns; bad input is answered
+// with a message and a non-zero status.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <iterator>
+
+#include "accel/accel.h"
+
+namespace raypack {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path temp_dir() {
+    const fs::path d = fs::temp_directory_path() / "raypack_test_bench_cli";
+    fs::create_directories(d);
+    return d;
+}
+
+/// Exit status of `raypack bench ARGS` and what it printed (both streams).
+struct BenchRun {
+    int status = -1;
+    std::string output;
+};
+
+BenchRun run_bench(const std::string& args) {
+    const fs::path log = temp_dir() / "bench.log";
+    const int raw = std::system((std::string(RAYPACK_CLI) + " bench " + args + " >" + log.string() + " 2>&1").c_str());
+    BenchRun run;
+    run.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    std::ifstream in(log);
+    run.output.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    return run;
+}
+
+std::string first_line(const fs::path& p) {
+    std::ifstream in(p);
+    std::string line;
+    std::getline(in, line);
+    return line;
+}
+
+const char* const kRequiredFields[] = {"scene",           "accel",           "packet",          "rays",
+                                       "threads",         "build_ms",        "mrays_per_s_median",
+                                       "mrays_per_s_min", "mrays_per_s_max", "nodes_per_ray",
+                                       "prims_per_ray",   "memory_bytes",    "validated"};
+
+TEST(BenchCli, QuickRunValidatesEveryStructureWidthAndRayKind) {
+    const fs::path json = temp_dir() / "quick.json", csv = temp_dir() / "quick.csv";
+    fs::remove(json);
+    fs::remove(csv);
+    const BenchRun r = run_bench("--quick --json " + json.string() + " --csv " + csv.string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("elapsed"), std::string::npos) << "progress lines on stderr";
+
+    std::ifstream in(json);
+    const nlohmann::json rows = nlohmann::json::parse(in);
+    ASSERT_TRUE(rows.is_array());
+    std::set<std::string> accels, kinds;
+    std::set<std::pair<std::string, int>> widths;
+    for (const auto& row : rows) {
+        for (const char* field : kRequiredFields) ASSERT_TRUE(row.contains(field)) << field << " in " << row.dump();
+        EXPECT_EQ(row["validated"], true) << row.dump();
+        EXPECT_GT(row["mrays_per_s_median"].get<double>(), 0.0) << row.dump();
+        EXPECT_LE(row["mrays_per_s_min"].get<double>(), row["mrays_per_s_median"].get<double>()) << row.dump();
+        EXPECT_LE(row["mrays_per_s_median"].get<double>(), row["mrays_per_s_max"].get<double>()) << row.dump();
+        const std::string accel = row["accel"];
+        if (accel == "embree") {
+            EXPECT_TRUE(row["nodes_per_ray"].is_null()) << "Embree cannot count";
+        } else {
+            EXPECT_GT(row["prims_per_ray"].get<double>(), 0.0) << row.dump();
+        }
+        accels.insert(accel);
+        kinds.insert(row["rays"].get<std::string>());
+        widths.insert({accel, row["packet"].get<int>()});
+    }
+    for (const char* k : accel_kinds()) EXPECT_TRUE(accels.count(k)) << "no rows for " << k;
+    EXPECT_EQ(kinds, (std::set<std::string>{"camera", "shadow", "diffuse"}));
+    EXPECT_TRUE(widths.count({"bvh2", 4})) << "bvh2 packets of 4 missing";
+    EXPECT_EQ(rows.size() % 3, 0u) << "every (accel, width) for every ray kind";
+
+    const std::string header = first_line(csv);
+    for (const char* field : kRequiredFields) EXPECT_NE(header.find(field), std::string::npos) << field;
+    std::ifstream csv_in(csv);
+    std::size_t lines = 0;
+    for (std::string line; std::getline(csv_in, line);) ++lines;
+    EXPECT_EQ(lines, rows.size() + 1);
+}
+
+TEST(BenchCli, BadFlagsAreUsageErrors) {
+    for (const char* args : {"--accel nosuch", "--packet 3", "--rays camera,sideways", "--repeat 0", "--threads x",
+                             "--res 10", "--bogus", "--rays camera --rays-file x.rays"}) {
+        const BenchRun r = run_bench(args);
+        EXPECT_EQ(r.status, 2) << args << ": " << r.output;
+        EXPECT_NE(r.output.find("raypack bench"), std::string::npos) << args << ": " << r.output;
+    }
+}
+
+TEST(BenchCli, MissingFilesNameTheFile) {
+    const BenchRun scene = run_bench("/nonexistent/scene.nff --accel bvh2 --rays camera --res 8 8");
+    EXPECT_EQ(scene.status, 1);
+    EXPECT_NE(scene.output.find("/nonexistent/scene.nff"), std::string::npos) << scene.output;
+    const BenchRun rays = run_bench("gen:balls:1 --rays-file /nonexistent/x.rays --accel bvh2");
+    EXPECT_EQ(rays.status, 1);
+    EXPECT_NE(rays.output.find("/nonexistent/x.rays"), std::string::npos) << rays.output;
+    const BenchRun out = run_bench("gen:balls:1 --accel bvh2 --rays camera --res 8 8 --repeat 1 --json /nonexistent/dir/x.json");
+    EXPECT_EQ(out.status, 1);
+    EXPECT_NE(out.output.find("/nonexistent/dir/x.json"), std::string::npos) << out.output;
+}
+
+TEST(BenchCli, RaysFileIsTracedAndValidated) {
+    const fs::path rays = temp_dir() / "camera.rays";
+    const std::string make = std::string(RAYPACK_CLI) + " rays gen:balls:2 --kind diffuse --res 32 32 -o " + rays.string();
+    ASSERT_EQ(std::system(make.c_str()), 0);
+    const fs::path json = temp_dir() / "file.json";
+    const BenchRun r = run_bench("gen:balls:2 --rays-file " + rays.string() + " --accel bvh2,grid --repeat 1 --json " +
+                               json.string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    std::ifstream in(json);
+    const nlohmann::json rows = nlohmann::json::parse(in);
+    ASSERT_FALSE(rows.empty());
+    for (const auto& row : rows) EXPECT_EQ(row["rays"], "file:camera");
+}
+
+}  // namespace
+}  // namespace raypack
