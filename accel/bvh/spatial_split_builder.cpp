@@ -121,17 +121,19 @@ private:
         right = BuildRef::make(rr, r.prim());
     }
 
-    float plane(const SseBox& box, int axis, int bin) const {
+    static float plane(const SseBox& box, int axis, int bin, int bins) {
         const float lo = box.lo_at(axis), hi = box.hi_at(axis);
-        return lo + (hi - lo) * (float(bin) / float(bins_));
+        return lo + (hi - lo) * (float(bin) / float(bins));
     }
-    int spatial_bin(float x, float lo, float scale) const {
-        return std::clamp(int((x - lo) * scale), 0, bins_ - 1);
+    static int spatial_bin(float x, float lo, float scale, int bins) {
+        return std::clamp(int((x - lo) * scale), 0, bins - 1);
     }
 
     // Chops each reference into the bins it spans, counting where it enters
-    // and where it leaves (Stich et al. sec. 4.3).
+    // and where it leaves (Stich et al. sec. 4.3). Small nodes use few bins,
+    // as for object splits.
     SpatialSplit find_spatial_split(const RefList& refs, const SseBox& node_box, float inv_area) const {
+        const int bins = object_bins_for(refs.size(), bins_);
         SpatialSplit best;
         std::array<SseBox, kMaxSahBins> box;
         std::array<std::uint32_t, kMaxSahBins> entry, exit;
@@ -139,19 +141,19 @@ private:
         for (int a = 0; a < 3; ++a) {
             const float lo = node_box.lo_at(a), extent = node_box.hi_at(a) - lo;
             if (!(extent > 0)) continue;
-            const float scale = float(bins_) / extent;
-            std::fill_n(box.begin(), bins_, SseBox{});
-            std::fill_n(entry.begin(), bins_, 0u);
-            std::fill_n(exit.begin(), bins_, 0u);
+            const float scale = float(bins) / extent;
+            std::fill_n(box.begin(), bins, SseBox{});
+            std::fill_n(entry.begin(), bins, 0u);
+            std::fill_n(exit.begin(), bins, 0u);
             for (const BuildRef& r : refs) {
-                const int first = spatial_bin(SseBox::lane(r.lo, a), lo, scale);
-                const int last = std::max(first, spatial_bin(SseBox::lane(r.hi, a), lo, scale));
+                const int first = spatial_bin(SseBox::lane(r.lo, a), lo, scale, bins);
+                const int last = std::max(first, spatial_bin(SseBox::lane(r.hi, a), lo, scale, bins));
                 ++entry[first];
                 ++exit[last];
                 BuildRef rest = r;
                 for (int b = first; b < last; ++b) {
                     BuildRef part, next;
-                    split_ref(rest, a, plane(node_box, a, b + 1), part, next);
+                    split_ref(rest, a, plane(node_box, a, b + 1, bins), part, next);
                     box[b].extend(part.lo, part.hi);
                     rest = next;
                 }
@@ -159,19 +161,19 @@ private:
             }
             SseBox acc;
             std::uint32_t n_right = 0;
-            for (int b = bins_ - 1; b > 0; --b) {
+            for (int b = bins - 1; b > 0; --b) {
                 acc.extend(box[b]);
                 n_right += exit[b];
                 right_weighted[b] = n_right ? acc.half_area() * float(n_right) : 0.0f;
             }
             acc = SseBox{};
             std::uint32_t n_left = 0;
-            for (int b = 1; b < bins_; ++b) {
+            for (int b = 1; b < bins; ++b) {
                 acc.extend(box[b - 1]);
                 n_left += entry[b - 1];
                 if (n_left == 0 || right_weighted[b] == 0) continue;
                 const float cost = rule_.split_cost(acc.half_area() * float(n_left) + right_weighted[b], inv_area);
-                if (cost < best.cost) best = {a, b, plane(node_box, a, b), cost};
+                if (cost < best.cost) best = {a, b, plane(node_box, a, b, bins), cost};
             }
         }
         return best;
