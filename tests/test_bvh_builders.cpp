@@ -362,8 +362,7 @@ TEST_P(BuilderTree, IsWellFormed) {
         }
     }
     if (builder == "sbvh") {
-        // The budget stops spatial splits; the last ones may overshoot it a little.
-        EXPECT_LE(double(bvh.prim_index.size()), 1.3 * double(n) + 64.0);
+        EXPECT_LE(bvh.prim_index.size(), std::size_t(double(n) * double(config.reference_budget)));
     }
 }
 

@@ -181,8 +181,10 @@ private:
 
     // Distributes the references, splitting the straddling ones unless
     // keeping one whole on one side is cheaper (reference unsplitting, Stich
-    // et al. sec. 4.4). False if a side would stay empty.
+    // et al. sec. 4.4), and keeping them whole once the reference budget is
+    // spent. False if a side would stay empty.
     bool apply_spatial(const RefList& refs, const SpatialSplit& split, RefList& left, RefList& right) const {
+        std::size_t budget = ref_limit_ - refs_alive_;
         const int a = split.axis;
         const float x = split.position;
         // The sides as the split plane defines them, before unsplitting.
@@ -207,8 +209,10 @@ private:
             const float c_split = area_l * float(n_left) + area_r * float(n_right);
             const float c_left = l1.half_area() * float(n_left) + area_r * float(n_right - 1);
             const float c_right = area_l * float(n_left - 1) + r2.half_area() * float(n_right);
-            if (c_left < c_split && c_left <= c_right) { left.push_back(r); continue; }
-            if (c_right < c_split) { right.push_back(r); continue; }
+            const bool can_split = budget > 0;
+            if ((c_left < c_split || !can_split) && c_left <= c_right) { left.push_back(r); continue; }
+            if (c_right < c_split || !can_split) { right.push_back(r); continue; }
+            --budget;
             BuildRef lp, rp;
             split_ref(r, a, x, lp, rp);
             const bool has_l = !lp.box().empty(), has_r = !rp.box().empty();
