@@ -49,6 +49,24 @@ void split_triangle(const Vec3f (&v)[3], const Box3f& box, int axis, float posit
     if (right.empty()) right = Box3f{};
 }
 
+/// The parts of a sphere on either side of the plane, within the reference's
+/// current box: the side that holds a cap without the centre is narrower
+/// than the box (radius sqrt(r^2 - d^2) across the plane, padded for rounding).
+void split_sphere(const Vec3f& center, float radius, const Box3f& box, int axis, float position, Box3f& left,
+                  Box3f& right) {
+    split_box(box, axis, position, left, right);
+    const float d = position - center[axis];
+    Box3f& cap = d < 0 ? left : right;
+    if (cap.empty()) return;
+    const float rho = std::sqrt(std::max(0.0f, radius * radius - d * d)) * 1.0001f;
+    for (int a = 0; a < 3; ++a) {
+        if (a == axis) continue;
+        cap.lo[a] = std::max(cap.lo[a], center[a] - rho);
+        cap.hi[a] = std::min(cap.hi[a], center[a] + rho);
+    }
+    if (cap.empty()) cap = Box3f{};
+}
+
 }  // namespace
 
 Bvh2 build_scene_bvh2(const Scene& scene, const AccelConfig& config) {
@@ -67,10 +85,13 @@ Bvh2 build_scene_bvh2(const Scene& scene, const AccelConfig& config) {
     bc.reference_budget = config.reference_budget;
     if (config.builder == "sbvh") {
         // Triangles are cut exactly by the split plane (Stich et al. 2009,
-        // sec. 4.3); spheres and cones clip their boxes.
+        // sec. 4.3), spheres at the circle the plane cuts; cones clip their boxes.
         bc.split_reference = [&scene](std::uint32_t prim, const Box3f& box, int axis, float position, Box3f& left,
                                       Box3f& right) {
             const PrimRef ref = scene.prims[prim];
+            if (ref.kind == PrimKind::Sphere)
+                return split_sphere(scene.spheres.center[ref.index], scene.spheres.radius[ref.index], box, axis,
+                                    position, left, right);
             if (ref.kind != PrimKind::Triangle) return split_box(box, axis, position, left, right);
             const Vec3f v[3] = {scene.triangles.p0[ref.index], scene.triangles.p1[ref.index],
                                 scene.triangles.p2[ref.index]};
