@@ -153,8 +153,16 @@ std::vector<Rayf> test_rays(const Scene& scene, const Bvh2& bvh) {
 
 // ---- The oracle, once per scene ----------------------------------------------------
 
+/// Scenes are loaded once per process, the oracle's answers only when asked for.
+const Scene& scene_for(const std::string& spec) {
+    static std::map<std::string, std::unique_ptr<Scene>> cache;
+    auto& slot = cache[spec];
+    if (!slot) slot = std::make_unique<Scene>(load_spec(spec));
+    return *slot;
+}
+
 struct OracleAnswers {
-    Scene scene;
+    const Scene& scene;
     std::vector<Rayf> rays;     ///< closest-hit rays
     std::vector<Hitf> hits;
     std::vector<Rayf> shadow;   ///< any-hit rays
@@ -170,9 +178,8 @@ const OracleAnswers& oracle(const std::string& spec) {
     static std::map<std::string, std::unique_ptr<OracleAnswers>> cache;
     auto& slot = cache[spec];
     if (slot) return *slot;
-    slot = std::make_unique<OracleAnswers>();
+    slot = std::make_unique<OracleAnswers>(OracleAnswers{scene_for(spec), {}, {}, {}, {}});
     OracleAnswers& o = *slot;
-    o.scene = load_spec(spec);
     AccelConfig config;
     o.rays = test_rays(o.scene, build_scene_bvh2(o.scene, config));
     const BruteForce brute(o.scene, config.kernels);
@@ -232,12 +239,8 @@ bool layout_compiled(const std::string& kind) {
 
 // ---- Against the oracle -----------------------------------------------------------------
 
-using SceneAndBuilder = std::tuple<std::string, std::string>;
-
-class BuilderOracle : public ::testing::TestWithParam<SceneAndBuilder> {};
-
-TEST_P(BuilderOracle, EveryLayoutAndPacketWidthMatchesBruteForce) {
-    const auto& [spec, builder] = GetParam();
+/// Every layout and packet width against the oracle.
+void check_against_oracle(const std::string& spec, const std::string& builder) {
     const OracleAnswers& o = oracle(spec);
     for (const char* layout : {"bvh2", "bvh4", "bvh8"}) {
         if (!layout_compiled(layout)) continue;
@@ -266,18 +269,6 @@ TEST_P(BuilderOracle, EveryLayoutAndPacketWidthMatchesBruteForce) {
     }
 }
 
-std::string case_name(const ::testing::TestParamInfo<SceneAndBuilder>& info) {
-    std::string s = std::get<0>(info.param) + "_" + std::get<1>(info.param);
-    for (char& c : s)
-        if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
-    return s;
-}
-
-INSTANTIATE_TEST_SUITE_P(, BuilderOracle,
-                         ::testing::Combine(::testing::ValuesIn(scene_specs()),
-                                            ::testing::ValuesIn(builders())),
-                         case_name);
-
 // ---- What each builder promises about its tree ---------------------------------------------
 
 bool inside(const Box3f& inner, const Box3f& outer) {
@@ -290,11 +281,9 @@ bool overlaps(const Box3f& a, const Box3f& b) {
            b.lo.z <= a.hi.z;
 }
 
-class BuilderTree : public ::testing::TestWithParam<SceneAndBuilder> {};
-
-TEST_P(BuilderTree, IsWellFormed) {
-    const auto& [spec, builder] = GetParam();
-    const Scene& scene = oracle(spec).scene;
+/// Every primitive in a leaf (once, or at least once for sbvh), leaves within
+/// max_leaf_size, children inside their parents, leaves around their primitives.
+void check_tree(const Scene& scene, const std::string& builder) {
     AccelConfig config;
     config.builder = builder;
     const Bvh2 bvh = build_scene_bvh2(scene, config);
@@ -343,15 +332,38 @@ TEST_P(BuilderTree, IsWellFormed) {
     }
 }
 
-INSTANTIATE_TEST_SUITE_P(, BuilderTree,
+// ---- Each builder on each scene (one test, one process: the scene loads once) ----------------
+
+using SceneAndBuilder = std::tuple<std::string, std::string>;
+
+class BuilderOnScene : public ::testing::TestWithParam<SceneAndBuilder> {};
+
+TEST_P(BuilderOnScene, TreeIsWellFormedAndEveryLayoutMatchesBruteForce) {
+    const auto& [spec, builder] = GetParam();
+    {
+        SCOPED_TRACE("tree");
+        check_tree(scene_for(spec), builder);
+    }
+    check_against_oracle(spec, builder);
+}
+
+std::string case_name(const ::testing::TestParamInfo<SceneAndBuilder>& info) {
+    std::string s = std::get<0>(info.param) + "_" + std::get<1>(info.param);
+    for (char& c : s)
+        if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+    return s;
+}
+
+INSTANTIATE_TEST_SUITE_P(, BuilderOnScene,
                          ::testing::Combine(::testing::ValuesIn(scene_specs()),
                                             ::testing::ValuesIn(builders())),
                          case_name);
 
+
 // ---- Across builders and thread counts ------------------------------------------------------
 
 TEST(BvhBuilders, SahCostOrderOnTheBunny) {
-    const Scene& scene = oracle("bunny.obj").scene;
+    const Scene& scene = scene_for("bunny.obj");
     std::map<std::string, double> cost;
     for (const char* b : bvh_builder_names()) {
         AccelConfig config;
@@ -368,7 +380,7 @@ TEST(BvhBuilders, SahCostOrderOnTheBunny) {
 TEST(BvhBuilders, SpatialSplitsDuplicateReferencesOnSpheres) {
     // balls.nff: spheres of very different sizes; the duplicates must reach
     // the leaves (and the oracle test above then covers them).
-    const Scene& scene = oracle("balls.nff").scene;
+    const Scene& scene = scene_for("balls.nff");
     AccelConfig config;
     config.builder = "sbvh";
     const Bvh2 bvh = build_scene_bvh2(scene, config);
@@ -377,7 +389,7 @@ TEST(BvhBuilders, SpatialSplitsDuplicateReferencesOnSpheres) {
 
 TEST(BvhBuilders, BinnedTreeDoesNotDependOnThreadCount) {
     // The bunny is large enough for parallel binning at the top and parallel subtrees below.
-    const Scene& scene = oracle("bunny.obj").scene;
+    const Scene& scene = scene_for("bunny.obj");
     const AccelConfig config;
     std::vector<Bvh2> trees;
     for (int threads : {1, 2, 4}) {
@@ -392,7 +404,7 @@ TEST(BvhBuilders, BinnedTreeDoesNotDependOnThreadCount) {
 }
 
 TEST(BvhBuilders, UnknownBuilderIsAClearError) {
-    const Scene& scene = oracle("gen:tetra:3").scene;
+    const Scene& scene = scene_for("gen:tetra:3");
     AccelConfig config;
     config.builder = "fastest";
     try {

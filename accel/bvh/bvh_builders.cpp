@@ -6,6 +6,7 @@
 #include "accel/bvh/morton_builder.h"
 #include "accel/bvh/spatial_split_builder.h"
 #include "accel/bvh/sweep_sah_builder.h"
+#include "accel/names.h"
 
 namespace raypack {
 
@@ -14,14 +15,7 @@ std::span<const char* const> bvh_builder_names() {
     return names;
 }
 
-std::string bvh_builder_list() {
-    std::string list;
-    for (const char* name : bvh_builder_names()) {
-        if (!list.empty()) list += '|';
-        list += name;
-    }
-    return list;
-}
+std::string bvh_builder_list() { return names_joined(bvh_builder_names()); }
 
 bool is_bvh_builder(std::string_view name) {
     for (const char* n : bvh_builder_names())
