@@ -24,6 +24,7 @@
 #include <sstream>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "accel/accel.h"
@@ -400,6 +401,60 @@ TEST(BvhBuilders, BinnedTreeDoesNotDependOnThreadCount) {
         ASSERT_EQ(trees[t].nodes.size(), trees[0].nodes.size());
         EXPECT_EQ(0, std::memcmp(trees[t].nodes.data(), trees[0].nodes.data(), trees[0].nodes.size() * sizeof(Bvh2Node)));
         EXPECT_EQ(trees[t].prim_index, trees[0].prim_index);
+    }
+}
+
+/// Scenes that break naive builders: nothing, one primitive, piles of
+/// primitives with the same centre (no SAH split separates them), and a
+/// nest of triangles of every size around one centre.
+std::vector<std::pair<std::string, Scene>> degenerate_scenes() {
+    std::vector<std::pair<std::string, Scene>> scenes(4);
+    for (auto& entry : scenes) entry.second.materials.emplace_back();
+    scenes[0].first = "empty";
+    scenes[1].first = "one triangle";
+    scenes[1].second.add_triangle({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, 0);
+    scenes[2].first = "coincident";
+    for (int i = 0; i < 60; ++i) {
+        scenes[2].second.add_triangle({-1, -1, 0}, {1, -1, 0}, {0, 1, 0}, 0);
+        scenes[2].second.add_sphere({0, 0, 0}, 0.5f, 0);
+    }
+    scenes[3].first = "nested";
+    for (int i = 0; i < 300; ++i) {
+        const float s = std::ldexp(1.0f, i % 40 - 20) * (1.0f + float(i) / 300.0f);
+        scenes[3].second.add_triangle({-s, -s, float(i) * 1e-3f}, {s, -s, 0}, {0, s, -float(i) * 1e-3f}, 0);
+    }
+    for (auto& [name, scene] : scenes) scene.update_features();
+    return scenes;
+}
+
+TEST(BvhBuilders, DegenerateScenesMatchBruteForce) {
+    for (const auto& [name, scene] : degenerate_scenes()) {
+        std::mt19937 rng(7);
+        std::vector<Rayf> rays;
+        const Box3f box = scene.primitive_count() ? grown(scene_bounds(scene), 0.5f) : Box3f{{-1, -1, -1}, {1, 1, 1}};
+        for (int i = 0; i < 300; ++i) {
+            Rayf r;
+            r.org = random_point(rng, box);
+            r.dir = i % 3 ? random_direction(rng) : Vec3f{signed_zero(rng), signed_zero(rng), i % 2 ? 1.0f : -1.0f};
+            rays.push_back(r);
+        }
+        const BruteForce brute(scene, KernelChoice{});
+        std::vector<Hitf> want(rays.size());
+        brute.intersect(rays, want);
+        for (const std::string& builder : builders())
+            for (const char* layout : {"bvh2", "bvh4", "bvh8"}) {
+                if (!layout_compiled(layout)) continue;
+                AccelConfig config;
+                config.kind = layout;
+                config.builder = builder;
+                const auto accel = build_accel(scene, config);
+                std::vector<Hitf> got(rays.size());
+                accel->intersect(rays, got);
+                for (std::size_t i = 0; i < rays.size(); ++i)
+                    ASSERT_TRUE(same_hit(want[i], got[i]) || (want[i].found() && outside_own_box(scene, rays[i], want[i].prim, want[i].t)))
+                        << name << ", " << builder << ", " << layout << ", ray " << i << ": " << describe(rays[i])
+                        << "\n  oracle " << describe(want[i]) << ", got " << describe(got[i]);
+            }
     }
 }
 
