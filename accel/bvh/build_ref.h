@@ -141,13 +141,13 @@ struct ObjectBins {
         __m128 lo, hi;
         void extend(__m128 l, __m128 h) { lo = _mm_min_ps(lo, l); hi = _mm_max_ps(hi, h); }
     };
-    Box box[kMaxSahBins][3];                          // [bin][axis]
+    Box box[3][kMaxSahBins];                          // [axis][bin]: one shift per address
     alignas(16) std::int32_t count[kMaxSahBins][4];  // [bin][axis]
 
     explicit ObjectBins(int bin_count) : bins(bin_count) {
         const SseBox empty;
         for (int b = 0; b < bins; ++b) {
-            for (int a = 0; a < 3; ++a) box[b][a] = {empty.lo, empty.hi};
+            for (int a = 0; a < 3; ++a) box[a][b] = {empty.lo, empty.hi};
             _mm_store_si128(reinterpret_cast<__m128i*>(count[b]), _mm_setzero_si128());
         }
     }
@@ -157,9 +157,9 @@ struct ObjectBins {
             alignas(16) std::int32_t b[4];
             _mm_store_si128(reinterpret_cast<__m128i*>(b), map.bin_of(refs[i]));
             const __m128 lo = refs[i].lo, hi = refs[i].hi;
-            box[b[0]][0].extend(lo, hi);
-            box[b[1]][1].extend(lo, hi);
-            box[b[2]][2].extend(lo, hi);
+            box[0][b[0]].extend(lo, hi);
+            box[1][b[1]].extend(lo, hi);
+            box[2][b[2]].extend(lo, hi);
             ++count[b[0]][0];
             ++count[b[1]][1];
             ++count[b[2]][2];
@@ -169,7 +169,7 @@ struct ObjectBins {
     void merge(const ObjectBins& o) {
         for (int b = 0; b < bins; ++b)
             for (int a = 0; a < 3; ++a) {
-                box[b][a].extend(o.box[b][a].lo, o.box[b][a].hi);
+                box[a][b].extend(o.box[a][b].lo, o.box[a][b].hi);
                 count[b][a] += o.count[b][a];
             }
     }
@@ -183,8 +183,8 @@ struct ObjectBins {
         SseBox ax, ay, az;
         __m128i n = _mm_setzero_si128();
         for (int b = bins - 1; b > 0; --b) {
-            ax.extend(box[b][0].lo, box[b][0].hi), ay.extend(box[b][1].lo, box[b][1].hi),
-                az.extend(box[b][2].lo, box[b][2].hi);
+            ax.extend(box[0][b].lo, box[0][b].hi), ay.extend(box[1][b].lo, box[1][b].hi),
+                az.extend(box[2][b].lo, box[2][b].hi);
             n = _mm_add_epi32(n, load_count(b));
             right_weighted[b] = weighted(half_areas3(ax, ay, az), n);
         }
@@ -197,8 +197,8 @@ struct ObjectBins {
         ax = ay = az = SseBox{};
         n = _mm_setzero_si128();
         for (int b = 1; b < bins; ++b) {
-            const Box* bb = box[b - 1];
-            ax.extend(bb[0].lo, bb[0].hi), ay.extend(bb[1].lo, bb[1].hi), az.extend(bb[2].lo, bb[2].hi);
+            ax.extend(box[0][b - 1].lo, box[0][b - 1].hi), ay.extend(box[1][b - 1].lo, box[1][b - 1].hi),
+                az.extend(box[2][b - 1].lo, box[2][b - 1].hi);
             n = _mm_add_epi32(n, load_count(b - 1));
             const __m128 left_weighted = weighted(half_areas3(ax, ay, az), n);
             // Same operations, in the same order, as SahRule::split_cost.
@@ -225,7 +225,7 @@ struct ObjectBins {
 
     /// Boxes of the two sides of a split.
     void split_boxes(const BinnedSplit& split, SseBox& left, SseBox& right) const {
-        for (int b = 0; b < bins; ++b) (b < split.bin ? left : right).extend(box[b][split.axis].lo, box[b][split.axis].hi);
+        for (int b = 0; b < bins; ++b) (b < split.bin ? left : right).extend(box[split.axis][b].lo, box[split.axis][b].hi);
     }
 
 private:
