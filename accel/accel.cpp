@@ -7,6 +7,7 @@
 #include "accel/bvh/wide_bvh_accel.h"
 #include "accel/grid/grid_accel.h"
 #include "accel/kdtree/kdtree_accel.h"
+#include "accel/names.h"
 #include "accel/octree/octree_accel.h"
 #ifdef RAYPACK_HAVE_EMBREE
 #include "accel/embree/embree_accel.h"
@@ -34,14 +35,7 @@ std::span<const char* const> accel_kinds() {
     return kinds;
 }
 
-std::string accel_kinds_list() {
-    std::string list;
-    for (const char* k : accel_kinds()) {
-        if (!list.empty()) list += '|';
-        list += k;
-    }
-    return list;
-}
+std::string accel_kinds_list() { return names_joined(accel_kinds()); }
 
 std::unique_ptr<Accel> build_accel(const Scene& scene, const AccelConfig& config) {
     if (config.kind == "bvh2") return std::make_unique<Bvh2Accel>(scene, config);

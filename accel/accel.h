@@ -24,6 +24,8 @@ struct AccelStats {
     double sah_cost = 0;     ///< SAH cost for trees, 0 where it means nothing
     double refs_per_prim = 1;       ///< primitive references per primitive (> 1 where split or duplicated)
     std::size_t empty_leaves = 0;   ///< empty leaves, or empty cells for the grid
+    std::size_t primitives = 0;     ///< primitives in the scene the structure was built over
+    double bytes_per_prim() const { return primitives ? double(bytes) / double(primitives) : 0.0; }
 };
 
 /// Work of tracing rays one at a time: nodes (or grid cells) entered, inner
@@ -41,6 +43,11 @@ struct AccelConfig {
     int sah_bins = 32;
     float traversal_cost = 1.0f;   ///< SAH cost of visiting a node ...
     float intersection_cost = 1.0f;  ///< ... relative to one primitive test
+    /// BVH builder (bvh2, bvh4, bvh8): binned | sweep | morton | sbvh
+    /// (accel/bvh/bvh_builders.h); the wide layouts collapse its BVH2.
+    std::string builder = "binned";
+    float spatial_alpha = 1e-5f;     ///< sbvh: overlap (relative to the root) that makes spatial splits worth trying
+    float reference_budget = 1.3f;   ///< sbvh: at most this many references per primitive
 };
 
 class Accel {

@@ -3,14 +3,18 @@
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 
+#include "accel/bvh/bvh_builders.h"
+
 namespace raypack::app {
 
 std::vector<OptionSpec> accel_option_specs() {
-    return {{"--accel", "", 1}, {"--sphere", "", 1}, {"--triangle", "", 1}, {"--packet", "", 1}};
+    return {{"--accel", "", 1}, {"--sphere", "", 1}, {"--triangle", "", 1}, {"--packet", "", 1}, {"--builder", "", 1}};
 }
 
 std::string accel_options_help() {
     return "  --accel " + accel_kinds_list() + "  acceleration structure (default bvh2)\n"
+           "  --builder " + bvh_builder_list() + "  BVH builder for bvh2|bvh4|bvh8 (default binned):\n"
+           "                binned SAH, full-sweep SAH, Morton/LBVH, spatial splits (SBVH)\n"
            "  --sphere geometric|algebraic|precise     ray-sphere test (default geometric)\n"
            "  --triangle moeller|watertight|plane     ray-triangle test (default moeller)\n"
            "  --packet 1|4|8|16             rays per packet (default 1; 16 needs AVX-512)\n";
@@ -23,6 +27,13 @@ AccelConfig accel_config_from(const ParsedArgs& args) {
     for (const char* k : accel_kinds()) known |= config.kind == k;
     if (!known)
         throw UsageError("--accel: unknown structure '" + config.kind + "' (expected " + accel_kinds_list() + ")");
+    if (args.has("--builder")) {
+        config.builder = args.text("--builder");
+        if (!is_bvh_builder(config.builder))
+            throw UsageError("--builder: unknown builder '" + config.builder + "' (expected " + bvh_builder_list() + ")");
+        if (config.kind != "bvh2" && config.kind != "bvh4" && config.kind != "bvh8")
+            throw UsageError("--builder applies to bvh2, bvh4 and bvh8 only, not to --accel " + config.kind);
+    }
     const std::string sphere = args.text("--sphere", "geometric");
     if (sphere == "geometric") config.kernels.sphere = SphereMethod::Geometric;
     else if (sphere == "algebraic") config.kernels.sphere = SphereMethod::Algebraic;

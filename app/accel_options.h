@@ -7,7 +7,7 @@
 
 namespace raypack::app {
 
-/// --accel, --sphere, --triangle, --packet
+/// --accel, --builder, --sphere, --triangle, --packet
 std::vector<OptionSpec> accel_option_specs();
 AccelConfig accel_config_from(const ParsedArgs& args);
 /// --packet K, checked against what `accel` traverses natively.

@@ -96,6 +96,7 @@ int run_trace(const Args& args) {
         j["repeat"] = repeat;
         j["build_ms"] = as.build_ms;
         j["memory_bytes"] = as.bytes;
+        j["bytes_per_prim"] = as.bytes_per_prim();
         j["nodes"] = as.nodes;
         j["leaves"] = as.leaves;
         j["empty_leaves"] = as.empty_leaves;

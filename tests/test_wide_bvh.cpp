@@ -194,32 +194,6 @@ struct Mismatches {
     std::string first;        ///< the first few, with reproducing rays
 };
 
-/// A kernel may report a hit whose point lies outside the primitive's own
-/// bounding box: Moeller-Trumbore for a ray in the plane y = 0 and a triangle
-/// whose highest vertex is at y = -1.8e-16 (teapot), the algebraic sphere
-/// test on small far spheres (cancellation, kernels/sphere.h). No bounding
-/// volume structure can reproduce such hits, so a mismatch is excused (and
-/// counted) when every hit the structure missed is one.
-bool outside_own_box(const Scene& scene, const Rayf& ray, std::uint32_t prim, float t) {
-    const Box3f b = primitive_bounds(scene, prim);
-    for (int a = 0; a < 3; ++a) {
-        const double p = double(ray.org[a]) + double(t) * double(ray.dir[a]);
-        if (p < double(b.lo[a]) || p > double(b.hi[a])) return true;
-    }
-    return false;
-}
-
-/// True if some primitive is hit within [tnear, tfar] at a point inside its box.
-bool hit_inside_own_box(const Scene& scene, const KernelChoice& kernels, const Rayf& ray) {
-    const PrimitiveIntersector<float> isect{&scene, kernels};
-    for (std::uint32_t p = 0; p < scene.primitive_count(); ++p) {
-        Rayf r = ray;
-        Hitf h;
-        if (isect.intersect(p, r, h) && !outside_own_box(scene, ray, p, h.t)) return true;
-    }
-    return false;
-}
-
 Mismatches compare_hits(const Scene& scene, const std::vector<Rayf>& rays, const std::vector<Hitf>& want,
                         const std::vector<Hitf>& got) {
     Mismatches m;

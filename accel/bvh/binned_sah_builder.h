@@ -1,22 +1,17 @@
 #pragma once
 // Binned SAH construction (Wald, "On fast Construction of SAH-based Bounding
-// Volume Hierarchies", IEEE RT 2007). Sees only boxes and centres.
+// Volume Hierarchies", IEEE RT 2007), parallel with oneTBB: the large nodes
+// near the root bin in parallel over primitive ranges, the subtrees below
+// them build as parallel tasks. The tree does not depend on the thread count.
 #include <span>
 
+#include "accel/bvh/build_config.h"
 #include "accel/bvh/bvh2.h"
+#include "accel/bvh/bvh2_finalize.h"
 
 namespace raypack {
 
-struct BinnedSahConfig {
-    int bins = 32;
-    int max_leaf_size = 4;           ///< a node this small may become a leaf ...
-    float traversal_cost = 1.0f;     ///< ... when the SAH says a split costs more
-    float intersection_cost = 1.0f;
-};
-
-Bvh2 build_binned_sah(std::span<const Box3f> boxes, std::span<const Vec3f> centers, const BinnedSahConfig& config);
-
-/// SAH cost of a built tree, relative to one primitive test at the root.
-double sah_cost(const Bvh2& bvh, float traversal_cost, float intersection_cost);
+/// Builds over boxes[i], i = primitive number; centres are box centres.
+Bvh2 build_binned_sah(std::span<const Box3f> boxes, const BvhBuildConfig& config);
 
 }  // namespace raypack

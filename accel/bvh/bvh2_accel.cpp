@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "accel/bvh/build_from_scene.h"
+#include "accel/bvh/bvh2_finalize.h"
 #include "accel/bvh/bvh2_packet.h"
 #include "kernels/simd.h"
 
@@ -15,13 +16,15 @@ Bvh2Accel::Bvh2Accel(const Scene& scene, const AccelConfig& config) : scene_(&sc
     bvh_ = build_scene_bvh2(scene, config);
     const auto stop = std::chrono::steady_clock::now();
     stats_.name = "bvh2";
-    stats_.builder = "binned";
+    stats_.builder = config.builder;
     stats_.build_ms = std::chrono::duration<double, std::milli>(stop - start).count();
     stats_.nodes = bvh_.nodes.size();
     stats_.leaves = bvh_.leaves;
     stats_.depth = bvh_.depth;
     stats_.bytes = bvh_.nodes.size() * sizeof(Bvh2Node) + bvh_.prim_index.size() * sizeof(std::uint32_t);
     stats_.sah_cost = sah_cost(bvh_, config.traversal_cost, config.intersection_cost);
+    stats_.primitives = scene.primitive_count();
+    stats_.refs_per_prim = stats_.primitives ? double(bvh_.prim_index.size()) / double(stats_.primitives) : 1.0;
 }
 
 // Depth-first traversal, nearer child first, with an explicit stack.

@@ -1,7 +1,7 @@
 #pragma once
 // Scalar traversal of a BVH2, the reference path for every faster BVH.
 #include "accel/accel.h"
-#include "accel/bvh/binned_sah_builder.h"
+#include "accel/bvh/bvh2.h"
 
 namespace raypack {
 

@@ -36,13 +36,15 @@ WideBvhAccel<N, M, Test>::WideBvhAccel(const Scene& scene, const AccelConfig& co
     bvh_ = collapse_bvh<N, M>(binary, scene, cc);
     const auto stop = std::chrono::steady_clock::now();
     stats_.name = N == 4 ? "bvh4" : "bvh8";
-    stats_.builder = "binned";
+    stats_.builder = config.builder;
     stats_.build_ms = std::chrono::duration<double, std::milli>(stop - start).count();
     stats_.nodes = bvh_.nodes.size();
     stats_.leaves = bvh_.leaves;
     stats_.depth = bvh_.depth;
     stats_.bytes = bvh_.bytes();
     stats_.sah_cost = sah_cost(bvh_, config.traversal_cost, config.intersection_cost);
+    stats_.primitives = scene.primitive_count();
+    if (stats_.primitives) stats_.refs_per_prim = double(binary.prim_index.size()) / double(stats_.primitives);
 }
 
 template <int N, int M, NodeTest Test>
