@@ -17,10 +17,14 @@
 // planes, same widened reciprocals, same operand order), and the primitive
 // kernels are the single-ray ones with ray and primitive swapped between
 // broadcast and lanes, so every (ray, primitive) pair gives bit-identical
-// t, u, v and hit/miss. Only the choice among primitives hit at exactly the
-// same t may differ: leaves are visited in another order, and within a
-// block the packet keeps the last such primitive where the single ray
-// keeps the first.
+// t, u, v and hit/miss, and hit/miss and occlusion per ray are the single
+// ray's. What may differ is which of two nearly coincident hits is kept:
+// leaves are visited in another order, boxes are culled against the closest
+// hit so far, and neither a box's entry distance nor a kernel's t is exact,
+// so a primitive whose computed t lies a few ulps (at grazing angles more)
+// before another's may be culled in one order and not in the other. Among
+// hits at exactly the same t, a block keeps the last for the packet and the
+// first for the single ray. tests/test_wide_bvh_packet.cpp checks this.
 #include <bit>
 #include <cmath>
 #include <algorithm>
