@@ -221,6 +221,7 @@ TEST_P(EmbreeAgreement, PacketsMatchSingleRays) {
         rays.push_back(r);
     }
     const std::vector<Hitf> single = trace(embree, rays);
+    const float scene_size = length(box.extent());
     // Shadow rays from the single-ray hits to the first light.
     std::vector<Rayf> shadows;
     for (std::size_t i = 0; i < rays.size() && !scene.lights.empty(); ++i) {
@@ -244,8 +245,14 @@ TEST_P(EmbreeAgreement, PacketsMatchSingleRays) {
         std::string examples;
         for (std::size_t i = 0; i < rays.size(); ++i) {
             const Hitf &a = single[i], &b = packet[i];
+            // t within relative 1e-6, or, for hits right at the origin, the
+            // hit points within 1e-6 of the scene's size: Embree's packet and
+            // single-ray sphere tests round differently, e.g. on mount.nff
+            // t = 0.00265879929 vs 0.00265880674 from an origin 0.005 inside
+            // a sphere's surface (cancellation in either form).
             const bool ok = a.found() == b.found() &&
-                            (!a.found() || std::fabs(a.t - b.t) <= 1e-6f * std::max(a.t, b.t));
+                            (!a.found() || std::fabs(a.t - b.t) <= 1e-6f * std::max(a.t, b.t) ||
+                             std::fabs(a.t - b.t) * length(rays[i].dir) <= 1e-6f * scene_size);
             if (!ok && ++unlike <= 3)
                 examples += "\n  " + describe(rays[i]) + ": single " + describe(scene, a) + ", packet " +
                             describe(scene, b);
