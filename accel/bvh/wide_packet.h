@@ -28,9 +28,13 @@ struct WidePacketConfig {
 /// The default switch point for N-wide trees and packets of K, measured on
 /// camera and shadow rays of balls, mount, tetra, teapot and bunny (see the
 /// README).
+/// Sweeps of 0..K+1 (teapot and mount, camera and random-direction rays,
+/// --threads 1) put the best value between 2 and K / 2: lower suits camera
+/// rays, higher incoherent ones; differences between neighbours were within
+/// the noise of the shared machine.
 constexpr int default_wide_switch_below(int n, int k) {
     (void)n;
-    return k / 2;
+    return k == 4 ? 2 : k == 8 ? 4 : 6;
 }
 
 /// Closest hits (AnyHit = false) or occlusion (AnyHit = true: hits[i].prim
