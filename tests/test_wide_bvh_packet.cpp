@@ -26,7 +26,7 @@
 
 #include "accel/brute/brute_force.h"
 #include "accel/bvh/wide_bvh_accel.h"
-#include "render/camera_rays.h"
+#include "render/ray_sets.h"
 #include "scene/load.h"
 #include "tests/oracle_harness.h"
 
@@ -72,14 +72,6 @@ struct RaySet {
     std::vector<Rayf> rays;
     bool any_hit = false;
 };
-
-std::vector<Rayf> camera_rays(const Scene& scene, int size) {
-    const CameraFrame f = make_camera_frame(scene.camera, size, size);
-    std::vector<Rayf> rays;
-    for (int y = 0; y < size; ++y)
-        for (int x = 0; x < size; ++x) rays.push_back(camera_ray(f, float(x) + 0.5f, float(y) + 0.5f));
-    return rays;
-}
 
 /// Random origins in the scene box, random directions, half of them with a
 /// finite tfar: incoherent packets, where lanes part early.
@@ -188,9 +180,9 @@ void check_scene(const Scene& scene, const std::string& label) {
     std::mt19937 rng(4242);
     const bool big = scene.primitive_count() > 20000;  // the oracle is the slow part
     std::vector<RaySet> sets;
-    sets.push_back({"camera", camera_rays(scene, big ? 40 : 64)});
-    sets.push_back({"random", random_rays(scene, rng, big ? 1003 : 2003)});
-    sets.push_back({"adversarial", adversarial_rays(accel.bvh(), rng, big ? 600 : 1500)});
+    sets.push_back({"camera", camera_ray_set(scene, big ? 40 : 64, big ? 40 : 64)});
+    sets.push_back({"random", random_rays(scene, rng, big ? 503 : 1503)});
+    sets.push_back({"adversarial", adversarial_rays(accel.bvh(), rng, big ? 300 : 1000)});
     {
         const std::vector<Hitf> cam = trace(brute, 1, false, sets[0].rays);
         sets.push_back({"shadow", shadow_rays(scene, sets[0].rays, cam), true});

@@ -25,13 +25,13 @@ struct WidePacketConfig {
     int switch_below = 2;
 };
 
-/// The default switch point for N-wide trees and packets of K, measured on
-/// camera and shadow rays of balls, mount, tetra, teapot and bunny (see the
-/// README).
-/// Sweeps of 0..K+1 (teapot and mount, camera and random-direction rays,
-/// --threads 1) put the best value between 2 and K / 2: lower suits camera
-/// rays, higher incoherent ones; differences between neighbours were within
-/// the noise of the shared machine.
+/// The default switch point for N-wide trees and packets of K. Measured with
+/// raypack_bench --benchmark_filter=switch/ (teapot and mount at 512 x 512,
+/// one thread, CPU time): camera rays change by at most 5% anywhere in
+/// 0..K/2, best near 2..4; random-direction rays from the camera hits are
+/// 20-60% faster at K/4..K/2 than at 0 (never fall back; K = 16 on
+/// teapot's BVH8: 7.9 -> 12.6 Mrays/s). K + 1 (every lane alone from the
+/// root) halves camera rays' speed.
 constexpr int default_wide_switch_below(int n, int k) {
     (void)n;
     return k == 4 ? 2 : k == 8 ? 4 : 6;
