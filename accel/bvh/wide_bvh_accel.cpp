@@ -1,6 +1,9 @@
 #include "accel/bvh/wide_bvh_accel.h"
 
+#include <algorithm>
 #include <chrono>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "accel/bvh/binned_sah_builder.h"
@@ -72,6 +75,69 @@ void WideBvhAccel<N, M, Test>::intersect(std::span<const Rayf> rays, std::span<H
 template <int N, int M, NodeTest Test>
 void WideBvhAccel<N, M, Test>::occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const {
     trace<true>(rays, [&](std::size_t i, bool any, const Hitf&) { occluded[i] = any ? 1 : 0; });
+}
+
+namespace {
+int packet_slot(int width) { return width == 4 ? 0 : width == 8 ? 1 : 2; }
+}  // namespace
+
+template <int N, int M, NodeTest Test>
+bool WideBvhAccel<N, M, Test>::supports_packet(int width) const {
+    if (width == 1) return true;
+    if constexpr (kPackets) {
+        switch (width) {
+            case 4: return kWidthCompiled<4>;
+            case 8: return kWidthCompiled<8>;
+            case 16: return kWidthCompiled<16>;
+        }
+    }
+    return false;
+}
+
+template <int N, int M, NodeTest Test>
+void WideBvhAccel<N, M, Test>::set_packet_config(int width, const WidePacketConfig& config) {
+    packet_config_[packet_slot(width)] = config;
+}
+
+template <int N, int M, NodeTest Test>
+WidePacketConfig WideBvhAccel<N, M, Test>::packet_config(int width) const {
+    return packet_config_[packet_slot(width)];
+}
+
+template <int N, int M, NodeTest Test>
+template <bool AnyHit>
+void WideBvhAccel<N, M, Test>::trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
+    if constexpr (kPackets) {
+        const WidePacketConfig& c = packet_config_[packet_slot(width)];
+        if constexpr (kWidthCompiled<4>)
+            if (width == 4) return wide_trace_packets<N, M, 4, AnyHit>(bvh_, kernels_, c, rays, hits);
+        if constexpr (kWidthCompiled<8>)
+            if (width == 8) return wide_trace_packets<N, M, 8, AnyHit>(bvh_, kernels_, c, rays, hits);
+        if constexpr (kWidthCompiled<16>)
+            if (width == 16) return wide_trace_packets<N, M, 16, AnyHit>(bvh_, kernels_, c, rays, hits);
+    }
+    throw std::invalid_argument(stats_.name + ": packets of " + std::to_string(width) + " are not compiled in");
+}
+
+template <int N, int M, NodeTest Test>
+void WideBvhAccel<N, M, Test>::intersect_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
+    if (width == 1 || !supports_packet(width)) return intersect(rays, hits);
+    trace_packets<false>(width, rays, hits);
+}
+
+template <int N, int M, NodeTest Test>
+void WideBvhAccel<N, M, Test>::occluded_packets(int width, std::span<const Rayf> rays,
+                                                std::span<std::uint8_t> occluded) const {
+    if (width == 1 || !supports_packet(width)) return this->occluded(rays, occluded);
+    // The packet loop reports occlusion as prim 0 (accel/packet_driver.h):
+    // traced in slices through a small buffer.
+    constexpr std::size_t kSlice = 256;
+    Hitf buffer[kSlice];
+    for (std::size_t first = 0; first < rays.size(); first += kSlice) {
+        const std::size_t n = std::min(kSlice, rays.size() - first);
+        trace_packets<true>(width, rays.subspan(first, n), std::span<Hitf>(buffer, n));
+        for (std::size_t i = 0; i < n; ++i) occluded[first + i] = buffer[i].found() ? 1 : 0;
+    }
 }
 
 #if defined(__SSE4_2__)

@@ -4,6 +4,7 @@
 // with SIMD node tests (accel/bvh/wide_traversal.h).
 #include "accel/accel.h"
 #include "accel/bvh/collapse.h"
+#include "accel/bvh/wide_packet.h"
 #include "accel/bvh/wide_traversal.h"
 
 namespace raypack {
@@ -21,6 +22,15 @@ public:
     bool count_traversal(std::span<const Rayf> rays, bool any_hit, std::span<Hitf> hits, TraversalCounts& counts) const override;  // wide_counting.cpp
     const WideBvh<N, M>& bvh() const { return bvh_; }
 
+    /// Packets of 4, 8, 16 (as compiled in) for the Ordered node test and
+    /// blocks of 8 (accel/bvh/wide_packet.h); other variants trace single rays.
+    bool supports_packet(int width) const override;
+    void intersect_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const override;
+    void occluded_packets(int width, std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override;
+    /// When packets of `width` fall back to single rays (for measurements and tests).
+    void set_packet_config(int width, const WidePacketConfig& config);
+    WidePacketConfig packet_config(int width) const;
+
     /// The collapse settings a config implies (N-wide node and M-wide block costs).
     static CollapseConfig collapse_config(const AccelConfig& config);
 
@@ -28,7 +38,13 @@ private:
     template <bool AnyHit, class Out>
     void trace(std::span<const Rayf> rays, Out&& out) const;
 
+    template <bool AnyHit>
+    void trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const;
+
+    static constexpr bool kPackets = M == 8 && Test == NodeTest::Ordered;
     KernelChoice kernels_;
+    WidePacketConfig packet_config_[3] = {{default_wide_switch_below(N, 4)}, {default_wide_switch_below(N, 8)},
+                                          {default_wide_switch_below(N, 16)}};  ///< K = 4, 8, 16
     WideBvh<N, M> bvh_;
     AccelStats stats_;
 };

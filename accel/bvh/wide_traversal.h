@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "accel/bvh/bvh2.h"  // kBvhMaxDepth
 #include "accel/bvh/wide_bvh.h"
 #include "accel/bvh/wide_node_test.h"
 
@@ -113,25 +114,22 @@ RAYPACK_INLINE bool intersect_leaf(const WideBvh<N, M>& bvh, SphereMethod sm, st
     return found;
 }
 
-/// Closest hit (AnyHit = false: `hit` gets the nearest) or any hit (returns
-/// at the first) of one ray.
-/// Closest hit (AnyHit = false: `hit` gets the nearest, the return value
-/// says whether there is one) or any hit (returns true at the first) of one
-/// ray in [tnear, tfar].
+/// One ray through the subtree under child slot `root` (an inner node or a
+/// leaf), with `tfar` the current closest hit distance (shrunk on hits) and
+/// `hit` the current closest hit: the traversal of trace_wide, and the
+/// single-ray fallback of the packet traversal (accel/bvh/wide_packet.h).
+/// True if it found a hit (any hit: returns at the first).
 template <int N, int M, TriangleMethod TM, NodeTest Test, bool AnyHit>
-bool trace_wide(const WideBvh<N, M>& bvh, SphereMethod sphere_method, const Rayf& ray, Hitf& hit) {
+RAYPACK_INLINE bool trace_wide_subtree(const WideBvh<N, M>& bvh, SphereMethod sphere_method, std::uint32_t root,
+                                       const NodeRay<N>& nr, const LeafRay<vfloat<M>>& lr, float& tfar, Hitf& hit) {
     using F = vfloat<N>;
-    if (bvh.nodes.empty()) return false;
-    const NodeRay<N> nr = make_node_ray<Test, N>(ray);
-    const LeafRay<vfloat<M>> lr = make_leaf_ray<vfloat<M>>(ray, TM);
-    float tfar = ray.tfar;
     // Every level but the leaves pushes at most N - 1 entries.
     constexpr int kStackSize = (N - 1) * kBvhMaxDepth + 1;
     WideStackEntry stack[kStackSize];
     WideStackEntry* sp = stack;
     const WideNode<N>* nodes = bvh.nodes.data();
     F tfar_v(tfar);
-    std::uint32_t cur = 0;
+    std::uint32_t cur = root;
     bool found = false;
     for (;;) {
         while (!wide_child::is_leaf(cur)) {
@@ -195,6 +193,17 @@ bool trace_wide(const WideBvh<N, M>& bvh, SphereMethod sphere_method, const Rayf
         }
         cur = sp->node;
     }
+}
+
+/// Closest hit (AnyHit = false: `hit` gets the nearest, the return value
+/// says whether there is one) or any hit (returns true at the first) of one
+/// ray in [tnear, tfar].
+template <int N, int M, TriangleMethod TM, NodeTest Test, bool AnyHit>
+bool trace_wide(const WideBvh<N, M>& bvh, SphereMethod sphere_method, const Rayf& ray, Hitf& hit) {
+    if (bvh.nodes.empty()) return false;
+    float tfar = ray.tfar;
+    return trace_wide_subtree<N, M, TM, Test, AnyHit>(bvh, sphere_method, 0, make_node_ray<Test, N>(ray),
+                                                      make_leaf_ray<vfloat<M>>(ray, TM), tfar, hit);
 }
 
 }  // namespace raypack

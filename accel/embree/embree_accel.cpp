@@ -152,37 +152,93 @@ void cone_bounds(const RTCBoundsFunctionArguments* args) {
     b->upper_z = std::nextafter(float(hi[2]), inf);
 }
 
+// Embree calls these with N = 1 from rtcIntersect1 and with N up to the
+// packet width from rtcIntersect4/8/16 (valid[i] = -1 for an active lane).
 void cone_intersect(const RTCIntersectFunctionNArguments* args) {
-    if (!args->valid[0]) return;
-    assert(args->N == 1);  // rtcIntersect1 only
+    const unsigned n = args->N;
     const EmbreeCone& c = static_cast<const EmbreeCone*>(args->geometryUserPtr)[args->primID];
-    RTCRayN* ray = RTCRayHitN_RayN(args->rayhit, 1);
-    RTCHitN* hit = RTCRayHitN_HitN(args->rayhit, 1);
-    const Vec3d org{RTCRayN_org_x(ray, 1, 0), RTCRayN_org_y(ray, 1, 0), RTCRayN_org_z(ray, 1, 0)};
-    const Vec3d dir{RTCRayN_dir_x(ray, 1, 0), RTCRayN_dir_y(ray, 1, 0), RTCRayN_dir_z(ray, 1, 0)};
-    ConeHit h;
-    if (!cone_hit(c, org, dir, RTCRayN_tnear(ray, 1, 0), RTCRayN_tfar(ray, 1, 0), h)) return;
-    RTCRayN_tfar(ray, 1, 0) = float(h.t);
-    RTCHitN_Ng_x(hit, 1, 0) = float(h.normal.x);
-    RTCHitN_Ng_y(hit, 1, 0) = float(h.normal.y);
-    RTCHitN_Ng_z(hit, 1, 0) = float(h.normal.z);
-    RTCHitN_u(hit, 1, 0) = float(h.z / c.h);  // like raypack: axial fraction from the base
-    RTCHitN_v(hit, 1, 0) = 0.0f;
-    RTCHitN_primID(hit, 1, 0) = args->primID;
-    RTCHitN_geomID(hit, 1, 0) = args->geomID;
-    RTCHitN_instID(hit, 1, 0, 0) = args->context->instID[0];
+    RTCRayN* ray = RTCRayHitN_RayN(args->rayhit, n);
+    RTCHitN* hit = RTCRayHitN_HitN(args->rayhit, n);
+    for (unsigned i = 0; i < n; ++i) {
+        if (!args->valid[i]) continue;
+        const Vec3d org{RTCRayN_org_x(ray, n, i), RTCRayN_org_y(ray, n, i), RTCRayN_org_z(ray, n, i)};
+        const Vec3d dir{RTCRayN_dir_x(ray, n, i), RTCRayN_dir_y(ray, n, i), RTCRayN_dir_z(ray, n, i)};
+        ConeHit h;
+        if (!cone_hit(c, org, dir, RTCRayN_tnear(ray, n, i), RTCRayN_tfar(ray, n, i), h)) continue;
+        RTCRayN_tfar(ray, n, i) = float(h.t);
+        RTCHitN_Ng_x(hit, n, i) = float(h.normal.x);
+        RTCHitN_Ng_y(hit, n, i) = float(h.normal.y);
+        RTCHitN_Ng_z(hit, n, i) = float(h.normal.z);
+        RTCHitN_u(hit, n, i) = float(h.z / c.h);  // like raypack: axial fraction from the base
+        RTCHitN_v(hit, n, i) = 0.0f;
+        RTCHitN_primID(hit, n, i) = args->primID;
+        RTCHitN_geomID(hit, n, i) = args->geomID;
+        RTCHitN_instID(hit, n, i, 0) = args->context->instID[0];
+    }
 }
 
 void cone_occluded(const RTCOccludedFunctionNArguments* args) {
-    if (!args->valid[0]) return;
-    assert(args->N == 1);  // rtcOccluded1 only
+    const unsigned n = args->N;
     const EmbreeCone& c = static_cast<const EmbreeCone*>(args->geometryUserPtr)[args->primID];
     RTCRayN* ray = args->ray;
-    const Vec3d org{RTCRayN_org_x(ray, 1, 0), RTCRayN_org_y(ray, 1, 0), RTCRayN_org_z(ray, 1, 0)};
-    const Vec3d dir{RTCRayN_dir_x(ray, 1, 0), RTCRayN_dir_y(ray, 1, 0), RTCRayN_dir_z(ray, 1, 0)};
-    ConeHit h;
-    if (cone_hit(c, org, dir, RTCRayN_tnear(ray, 1, 0), RTCRayN_tfar(ray, 1, 0), h))
-        RTCRayN_tfar(ray, 1, 0) = -std::numeric_limits<float>::infinity();
+    for (unsigned i = 0; i < n; ++i) {
+        if (!args->valid[i]) continue;
+        const Vec3d org{RTCRayN_org_x(ray, n, i), RTCRayN_org_y(ray, n, i), RTCRayN_org_z(ray, n, i)};
+        const Vec3d dir{RTCRayN_dir_x(ray, n, i), RTCRayN_dir_y(ray, n, i), RTCRayN_dir_z(ray, n, i)};
+        ConeHit h;
+        if (cone_hit(c, org, dir, RTCRayN_tnear(ray, n, i), RTCRayN_tfar(ray, n, i), h))
+            RTCRayN_tfar(ray, n, i) = -std::numeric_limits<float>::infinity();
+    }
+}
+
+// ---- Packets of K rays -------------------------------------------------------
+//
+// Embree's packet types carry their own alignment (RTC_ALIGN(16/32/64) on
+// RTCRayHit4/8/16), which holds for locals; the valid masks get the same.
+
+template <int K> struct EmbreePacket;
+template <> struct EmbreePacket<4> {
+    using RayHit = RTCRayHit4;
+    using Ray = RTCRay4;
+    static void intersect(const int* v, RTCScene s, RTCIntersectContext* c, RayHit* r) { rtcIntersect4(v, s, c, r); }
+    static void occluded(const int* v, RTCScene s, RTCIntersectContext* c, Ray* r) { rtcOccluded4(v, s, c, r); }
+};
+template <> struct EmbreePacket<8> {
+    using RayHit = RTCRayHit8;
+    using Ray = RTCRay8;
+    static void intersect(const int* v, RTCScene s, RTCIntersectContext* c, RayHit* r) { rtcIntersect8(v, s, c, r); }
+    static void occluded(const int* v, RTCScene s, RTCIntersectContext* c, Ray* r) { rtcOccluded8(v, s, c, r); }
+};
+template <> struct EmbreePacket<16> {
+    using RayHit = RTCRayHit16;
+    using Ray = RTCRay16;
+    static void intersect(const int* v, RTCScene s, RTCIntersectContext* c, RayHit* r) { rtcIntersect16(v, s, c, r); }
+    static void occluded(const int* v, RTCScene s, RTCIntersectContext* c, Ray* r) { rtcOccluded16(v, s, c, r); }
+};
+static_assert(alignof(RTCRayHit4) >= 16 && alignof(RTCRayHit8) >= 32 && alignof(RTCRayHit16) >= 64);
+
+/// Fills lanes [0, K) of `ray` from up to K rays and sets `valid`: -1 for a
+/// ray, 0 for the lanes past the end (which repeat the last ray, so that
+/// even an inactive lane holds finite numbers).
+template <int K, class RayK>
+void load_embree_packet(std::span<const Rayf> rays, RayK& ray, int (&valid)[K]) {
+    for (int i = 0; i < K; ++i) {
+        const std::size_t src = std::min<std::size_t>(std::size_t(i), rays.size() - 1);
+        const Rayf& r = rays[src];
+        ray.org_x[i] = r.org.x;
+        ray.org_y[i] = r.org.y;
+        ray.org_z[i] = r.org.z;
+        ray.tnear[i] = r.tnear;
+        ray.dir_x[i] = r.dir.x;
+        ray.dir_y[i] = r.dir.y;
+        ray.dir_z[i] = r.dir.z;
+        ray.time[i] = 0.0f;
+        ray.tfar[i] = r.tfar;
+        ray.mask[i] = 0xFFFFFFFFu;
+        ray.id[i] = unsigned(i);
+        ray.flags[i] = 0;
+        valid[i] = std::size_t(i) < rays.size() ? -1 : 0;
+    }
 }
 
 }  // namespace
@@ -225,7 +281,13 @@ EmbreeAccel::EmbreeAccel(const Scene& scene) {
     }
     const auto stop = std::chrono::steady_clock::now();
     stats_.name = "embree";
-    stats_.builder = "embree-high-robust";
+    native_[0] = rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_NATIVE_RAY4_SUPPORTED) != 0;
+    native_[1] = rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED) != 0;
+    native_[2] = rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) != 0;
+    // The builder text says which packet widths this Embree traces natively
+    // (an emulated width is split into single rays inside Embree).
+    stats_.builder = "embree-high-robust, packets 4/8/16 ";
+    for (int k = 0; k < 3; ++k) stats_.builder += std::string(k ? "/" : "") + (native_[k] ? "native" : "emulated");
     stats_.build_ms = std::chrono::duration<double, std::milli>(stop - start).count();
     const std::int64_t bytes = allocated_.load();
     stats_.bytes = bytes > 0 ? std::size_t(bytes) : 0;  // geometry buffers included
@@ -364,6 +426,84 @@ void EmbreeAccel::occluded(std::span<const Rayf> rays, std::span<std::uint8_t> o
         rtcOccluded1(scene_, &context, &ray);
         // Embree marks an occluded ray by setting tfar to -inf.
         occluded[i] = ray.tfar == -std::numeric_limits<float>::infinity() ? 1 : 0;
+    }
+}
+
+bool EmbreeAccel::native_packet(int width) const {
+    switch (width) {
+        case 1: return true;
+        case 4: return native_[0];
+        case 8: return native_[1];
+        case 16: return native_[2];
+        default: return false;
+    }
+}
+
+template <int K>
+void EmbreeAccel::intersect_k(std::span<const Rayf> rays, std::span<Hitf> hits) const {
+    const DenormalsOff ftz;
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);  // default flags: incoherent (see intersect_packets)
+    for (std::size_t first = 0; first < rays.size(); first += K) {
+        const std::size_t n = std::min<std::size_t>(K, rays.size() - first);
+        typename EmbreePacket<K>::RayHit rh;
+        alignas(64) int valid[K];
+        load_embree_packet<K>(rays.subspan(first, n), rh.ray, valid);
+        for (int i = 0; i < K; ++i) {
+            rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+            rh.hit.primID[i] = RTC_INVALID_GEOMETRY_ID;
+            rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+        }
+        EmbreePacket<K>::intersect(valid, scene_, &context, &rh);
+        for (std::size_t i = 0; i < n; ++i) {
+            Hitf hit;
+            if (rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID) {
+                hit.t = rh.ray.tfar[i];
+                hit.prim = to_global_[rh.hit.geomID[i]][rh.hit.primID[i]];
+                hit.u = rh.hit.u[i];
+                hit.v = rh.hit.v[i];
+            }
+            hits[first + i] = hit;
+        }
+    }
+}
+
+template <int K>
+void EmbreeAccel::occluded_k(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const {
+    const DenormalsOff ftz;
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    for (std::size_t first = 0; first < rays.size(); first += K) {
+        const std::size_t n = std::min<std::size_t>(K, rays.size() - first);
+        typename EmbreePacket<K>::Ray ray;
+        alignas(64) int valid[K];
+        load_embree_packet<K>(rays.subspan(first, n), ray, valid);
+        EmbreePacket<K>::occluded(valid, scene_, &context, &ray);
+        for (std::size_t i = 0; i < n; ++i)
+            occluded[first + i] = ray.tfar[i] == -std::numeric_limits<float>::infinity() ? 1 : 0;
+    }
+}
+
+// The context keeps rtcInitIntersectContext's default flags (INCOHERENT),
+// the mode Embree documents for general use. RTC_INTERSECT_CONTEXT_FLAG_COHERENT
+// would switch Embree 3.13's packet traversal of triangle-only BVHs to a
+// frustum path (BVHNIntersectorKHybrid::intersectCoherent), a promise about
+// the rays that raypack's shadow and diffuse ray sets do not keep.
+void EmbreeAccel::intersect_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
+    switch (width) {
+        case 4: return intersect_k<4>(rays, hits);
+        case 8: return intersect_k<8>(rays, hits);
+        case 16: return intersect_k<16>(rays, hits);
+        default: return intersect(rays, hits);
+    }
+}
+
+void EmbreeAccel::occluded_packets(int width, std::span<const Rayf> rays, std::span<std::uint8_t> occluded_out) const {
+    switch (width) {
+        case 4: return occluded_k<4>(rays, occluded_out);
+        case 8: return occluded_k<8>(rays, occluded_out);
+        case 16: return occluded_k<16>(rays, occluded_out);
+        default: return occluded(rays, occluded_out);
     }
 }
 

@@ -37,7 +37,24 @@ public:
     void occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override;
     const AccelStats& stats() const override { return stats_; }
 
+    /// Packets of 4, 8 and 16 go through rtcIntersect4/8/16 and
+    /// rtcOccluded4/8/16; width 1 through rtcIntersect1 / rtcOccluded1.
+    bool supports_packet(int width) const override {
+        return width == 1 || width == 4 || width == 8 || width == 16;
+    }
+    void intersect_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const override;
+    void occluded_packets(int width, std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override;
+    /// Whether this Embree build traces packets of `width` natively
+    /// (RTC_DEVICE_PROPERTY_NATIVE_RAY4/8/16_SUPPORTED); otherwise Embree
+    /// emulates them. Width 1 is always native.
+    bool native_packet(int width) const;
+
 private:
+    template <int K>
+    void intersect_k(std::span<const Rayf> rays, std::span<Hitf> hits) const;
+    template <int K>
+    void occluded_k(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const;
+
     void build(const Scene& scene);
     static bool memory_monitor(void* self, ssize_t bytes, bool post);
     static void on_error(void* self, RTCError code, const char* message);
@@ -52,6 +69,7 @@ private:
     mutable std::mutex error_mutex_;
     std::string first_error_;  ///< Embree's own message, reported by fail()
     AccelStats stats_;
+    bool native_[3] = {false, false, false};  ///< RAY4, RAY8, RAY16
 };
 
 }  // namespace raypack

@@ -1,0 +1,47 @@
+#pragma once
+// Packets of K rays through a BVH4 or BVH8 (Wald, Slusallek, Benthin,
+// Wagner, "Interactive Rendering with Coherent Ray Tracing", EG 2001, on the
+// wide trees of Dammertz et al. 2008), falling back to the single-ray wide
+// traversal when few lanes stay active (Benthin, Wald, Woop, Ernst, Mark,
+// "Combining Single and Packet-Ray Tracing for Arbitrary Ray Distributions
+// on the Intel MIC Architecture", IEEE TVCG 2012). The templates live in
+// accel/bvh/wide_packet_traversal.h and are instantiated per tree width in
+// wide_packet_bvh4.cpp and wide_packet_bvh8.cpp.
+#include <cstdint>
+#include <span>
+
+#include "accel/bvh/wide_bvh.h"
+#include "accel/primitive_intersector.h"
+#include "kernels/ray.h"
+
+namespace raypack {
+
+/// When a packet leaves the packet traversal for single rays.
+struct WidePacketConfig {
+    /// At a node (inner or leaf) reached by fewer active lanes than this,
+    /// each of those lanes traces the subtree alone with the single-ray
+    /// wide traversal (trace_wide_subtree). 0: never; K + 1: always, so the
+    /// packet only shares the root.
+    int switch_below = 2;
+};
+
+/// The default switch point for N-wide trees and packets of K. Measured with
+/// raypack_bench --benchmark_filter=switch/ (teapot and mount at 512 x 512,
+/// one thread, CPU time): camera rays change by at most 5% anywhere in
+/// 0..K/2, best near 2..4; random-direction rays from the camera hits are
+/// 20-60% faster at K/4..K/2 than at 0 (never fall back; K = 16 on
+/// teapot's BVH8: 7.9 -> 12.6 Mrays/s). K + 1 (every lane alone from the
+/// root) halves camera rays' speed.
+constexpr int default_wide_switch_below(int n, int k) {
+    (void)n;
+    return k == 4 ? 2 : k == 8 ? 4 : 6;
+}
+
+/// Closest hits (AnyHit = false) or occlusion (AnyHit = true: hits[i].prim
+/// = 0 where occluded) of `rays` in packets of K consecutive rays. Defined
+/// for N = 4, 8 with M = 8 and the K that are compiled in (kWidthCompiled).
+template <int N, int M, int K, bool AnyHit>
+void wide_trace_packets(const WideBvh<N, M>& bvh, KernelChoice kernels, const WidePacketConfig& config,
+                        std::span<const Rayf> rays, std::span<Hitf> hits);
+
+}  // namespace raypack

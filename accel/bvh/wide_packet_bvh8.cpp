@@ -1,0 +1,26 @@
+// Packet traversal of the BVH8 (accel/bvh/wide_packet.h), one file per
+// tree width to keep compile times bounded.
+#include "accel/bvh/wide_packet_traversal.h"
+
+namespace raypack {
+
+#if defined(__SSE4_2__) && defined(__AVX2__)
+template void wide_trace_packets<8, 8, 4, false>(const WideBvh<8, 8>&, KernelChoice, const WidePacketConfig&,
+                                                  std::span<const Rayf>, std::span<Hitf>);
+template void wide_trace_packets<8, 8, 4, true>(const WideBvh<8, 8>&, KernelChoice, const WidePacketConfig&,
+                                                 std::span<const Rayf>, std::span<Hitf>);
+#endif
+#if defined(__AVX2__)
+template void wide_trace_packets<8, 8, 8, false>(const WideBvh<8, 8>&, KernelChoice, const WidePacketConfig&,
+                                                  std::span<const Rayf>, std::span<Hitf>);
+template void wide_trace_packets<8, 8, 8, true>(const WideBvh<8, 8>&, KernelChoice, const WidePacketConfig&,
+                                                 std::span<const Rayf>, std::span<Hitf>);
+#endif
+#if defined(__AVX512BW__)
+template void wide_trace_packets<8, 8, 16, false>(const WideBvh<8, 8>&, KernelChoice, const WidePacketConfig&,
+                                                   std::span<const Rayf>, std::span<Hitf>);
+template void wide_trace_packets<8, 8, 16, true>(const WideBvh<8, 8>&, KernelChoice, const WidePacketConfig&,
+                                                  std::span<const Rayf>, std::span<Hitf>);
+#endif
+
+}  // namespace raypack

@@ -1,0 +1,398 @@
+#pragma once
+// The packet traversal of accel/bvh/wide_packet.h, included only by the
+// .cpp files that instantiate it.
+//
+// One packet of K rays descends the N-wide tree together: each child box is
+// tested against all active lanes (K rays x 1 box), a child is entered by
+// the lanes that meet it before their current closest hit, and the hit
+// children are visited nearest first for the first active lane ("first
+// active" ordering: wide nodes store no split axis, so the order comes from
+// that lane's entry distances). Leaves test each primitive against the
+// active lanes (K rays x 1 primitive, broadcast from the leaf block). When
+// fewer than WidePacketConfig::switch_below lanes reach a node, each of them
+// finishes that subtree as a single ray (Benthin et al. 2012), with the
+// single-ray wide traversal and its 1 x N node and 1 x M block tests.
+//
+// Results: the node test is the single-ray Ordered test lane by lane (same
+// planes, same widened reciprocals, same operand order), and the primitive
+// kernels are the single-ray ones with ray and primitive swapped between
+// broadcast and lanes, so every (ray, primitive) pair gives bit-identical
+// t, u, v and hit/miss, and hit/miss and occlusion per ray are the single
+// ray's. What may differ is which of two nearly coincident hits is kept:
+// leaves are visited in another order, boxes are culled against the closest
+// hit so far, and neither a box's entry distance nor a kernel's t is exact,
+// so a primitive whose computed t lies a few ulps (at grazing angles more)
+// before another's may be culled in one order and not in the other. Among
+// hits at exactly the same t, a block keeps the last for the packet and the
+// first for the single ray. tests/test_wide_bvh_packet.cpp checks this.
+#include <bit>
+#include <cmath>
+#include <algorithm>
+#include <cstdint>
+#include <limits>
+
+#include "accel/bvh/wide_packet.h"
+#include "accel/bvh/wide_traversal.h"
+#include "accel/packet_driver.h"
+#include "kernels/ray_packet.h"
+
+namespace raypack::wide_packet_detail {
+
+/// x with its bits plus one: the next float away from zero (finite x).
+template <class F>
+RAYPACK_INLINE F next_away_from_zero(const F& x) {
+    if constexpr (sizeof(F) == 16) {
+        return _mm_castsi128_ps(_mm_add_epi32(_mm_castps_si128(x), _mm_set1_epi32(1)));
+    } else if constexpr (sizeof(F) == 32) {
+        return _mm256_castsi256_ps(_mm256_add_epi32(_mm256_castps_si256(x), _mm256_set1_epi32(1)));
+    } else {
+#if defined(__AVX512F__)
+        return _mm512_castsi512_ps(_mm512_add_epi32(_mm512_castps_si512(x), _mm512_set1_epi32(1)));
+#endif
+    }
+}
+
+/// The packet as the node and leaf tests see it, computed once per packet.
+template <int K>
+struct PacketNodeRay {
+    using F = vfloat<K>;
+    Vec3<F> org, rdir, rdir_far;
+    vmask<K> neg_x, neg_y, neg_z;  ///< rdir < 0: the near plane is hi
+    F tnear;
+};
+
+/// make_node_ray<NodeTest::Ordered> (accel/bvh/wide_node_test.h) for K
+/// lanes: the same reciprocal, the same +-inf for a clamped component, the
+/// same widened far reciprocal.
+template <int K>
+RAYPACK_INLINE PacketNodeRay<K> make_packet_node_ray(const RayPacket<K>& p) {
+    using F = vfloat<K>;
+    const F inf(std::numeric_limits<float>::infinity());
+    PacketNodeRay<K> n;
+    auto axis = [&](const F& d, F& r, F& r_far, vmask<K>& negative) {
+        r = select(vabs(d) < F(kMinRcpInput), copysign_of(inf, d), F(1.0f) / d);
+        const F w = r * F(kFarWiden);
+        r_far = select(vabs(w) == inf, w, next_away_from_zero(w));
+        negative = r < F(0.0f);
+    };
+    axis(p.dir.x, n.rdir.x, n.rdir_far.x, n.neg_x);
+    axis(p.dir.y, n.rdir.y, n.rdir_far.y, n.neg_y);
+    axis(p.dir.z, n.rdir.z, n.rdir_far.z, n.neg_z);
+    n.org = p.org;
+    n.tnear = p.tnear;
+    return n;
+}
+
+/// make_leaf_ray for K lanes.
+template <int K>
+RAYPACK_INLINE LeafRay<vfloat<K>> make_packet_leaf_ray(const RayPacket<K>& p, TriangleMethod method) {
+    using F = vfloat<K>;
+    LeafRay<F> l;
+    l.org = p.org;
+    l.dir = p.dir;
+    l.tnear = p.tnear;
+    l.dd = fused_dot(p.dir, p.dir);
+    l.inv_dd = F(1.0f) / l.dd;
+    if (method == TriangleMethod::Watertight) l.watertight = make_watertight_ray<F>(p.org, p.dir);
+    return l;
+}
+
+/// Lanes of `active` that meet child box i of `node` before their `tfar`;
+/// `entry` gets the entry distances. Lane for lane the single-ray Ordered
+/// test: the near plane per axis picked by the lane's direction sign, NaN
+/// dropped by operand order.
+template <int N, int K>
+RAYPACK_INLINE vmask<K> child_hits(const WideNode<N>& node, int i, const PacketNodeRay<K>& r, const vmask<K>& active,
+                                   const vfloat<K>& tfar, vfloat<K>& entry) {
+    using F = vfloat<K>;
+    const F lx(node.bounds[0][i]), ly(node.bounds[1][i]), lz(node.bounds[2][i]);
+    const F hx(node.bounds[3][i]), hy(node.bounds[4][i]), hz(node.bounds[5][i]);
+    const F nx = (select(r.neg_x, hx, lx) - r.org.x) * r.rdir.x;
+    const F ny = (select(r.neg_y, hy, ly) - r.org.y) * r.rdir.y;
+    const F nz = (select(r.neg_z, hz, lz) - r.org.z) * r.rdir.z;
+    const F fx = (select(r.neg_x, lx, hx) - r.org.x) * r.rdir_far.x;
+    const F fy = (select(r.neg_y, ly, hy) - r.org.y) * r.rdir_far.y;
+    const F fz = (select(r.neg_z, lz, hz) - r.org.z) * r.rdir_far.z;
+    entry = vmax(vmax(nx, ny), vmax(nz, r.tnear));
+    const F exit = vmin(vmin(fx, fy), vmin(fz, tfar));
+    return active & (entry <= exit);
+}
+
+/// Primitive j of a block against the active lanes: the lanes that hit it
+/// before their tfar, with t, u, v.
+template <TriangleMethod TM, class F, int M>
+RAYPACK_INLINE mask_of<F> intersect_one(const TriangleBlock<M>& b, int j, SphereMethod, const LeafRay<F>& r,
+                                        const mask_of<F>& active, const F& tfar, F& t, F& u, F& v) {
+    const Vec3<F> p0{F(b.p0[0][j]), F(b.p0[1][j]), F(b.p0[2][j])};
+    const Vec3<F> a{F(b.a[0][j]), F(b.a[1][j]), F(b.a[2][j])};
+    const Vec3<F> c{F(b.b[0][j]), F(b.b[1][j]), F(b.b[2][j])};
+    if constexpr (TM == TriangleMethod::Moeller) {
+        const Vec3<F> ng{F(b.ng[0][j]), F(b.ng[1][j]), F(b.ng[2][j])};
+        return active & intersect_moeller_edges(r.org, r.dir, r.tnear, tfar, p0, a, c, ng, t, u, v);
+    } else if constexpr (TM == TriangleMethod::Watertight) {
+        return intersect_triangle_watertight<F>(active, r.watertight, r.tnear, tfar, p0, a, c, t, u, v);
+    } else {
+        return intersect_triangle_plane<F>(active, r.org, r.dir, r.tnear, tfar, p0, a, c, t, u, v);
+    }
+}
+
+template <TriangleMethod TM, class F, int M>
+RAYPACK_INLINE mask_of<F> intersect_one(const SphereBlock<M>& b, int j, SphereMethod method, const LeafRay<F>& r,
+                                        const mask_of<F>& active, const F& tfar, F& t, F& u, F& v) {
+    const QuadricRay<F> q{r.org, r.dir, r.tnear, tfar, r.dd, r.inv_dd};
+    const Vec3<F> c{F(b.center[0][j]), F(b.center[1][j]), F(b.center[2][j])};
+    const F radius(b.radius[j]);
+    u = v = F(0.0f);
+    switch (method) {
+        case SphereMethod::Algebraic: return intersect_sphere<SphereMethod::Algebraic, F>(active, q, c, radius, t);
+        case SphereMethod::Geometric: return intersect_sphere<SphereMethod::Geometric, F>(active, q, c, radius, t);
+        case SphereMethod::Precise: break;
+    }
+    return intersect_sphere<SphereMethod::Precise, F>(active, q, c, radius, t);
+}
+
+template <TriangleMethod TM, class F, int M>
+RAYPACK_INLINE mask_of<F> intersect_one(const ConeBlock<M>& b, int j, SphereMethod, const LeafRay<F>& r,
+                                        const mask_of<F>& active, const F& tfar, F& t, F& u, F& v) {
+    const QuadricRay<F> q{r.org, r.dir, r.tnear, tfar, r.dd, r.inv_dd};
+    ConeLanes<F> c;
+    c.base = {F(b.base[0][j]), F(b.base[1][j]), F(b.base[2][j])};
+    c.w = {F(b.w[0][j]), F(b.w[1][j]), F(b.w[2][j])};
+    c.mid = {F(b.mid[0][j]), F(b.mid[1][j]), F(b.mid[2][j])};
+    c.h = F(b.h[j]);
+    c.inv_h = F(b.inv_h[j]);
+    c.k = F(b.k[j]);
+    c.rb = F(b.rb[j]);
+    v = F(0.0f);
+    return intersect_cone<F>(active, q, c, t, u);
+}
+
+/// The per-packet state the leaves update: the closest hits so far, each
+/// lane's tfar (its closest t; -inf once an any-hit lane is occluded), the
+/// lanes still traced and, for any hit, the occluded ones.
+template <int K>
+struct PacketState {
+    using F = vfloat<K>;
+    HitPacket<K>& hit;
+    F tfar;
+    vmask<K> valid;
+    vmask<K>& occluded;
+};
+
+/// A run of blocks of one kind against the active lanes, one primitive at a
+/// time (padding lanes, prim = kNoPrim, end a block).
+template <TriangleMethod TM, bool AnyHit, int K, class Block>
+RAYPACK_INLINE void packet_run(const Block* b, std::uint32_t count, SphereMethod sm, const LeafRay<vfloat<K>>& r,
+                               vmask<K> active, PacketState<K>& s) {
+    using F = vfloat<K>;
+    constexpr int M = int(sizeof(b->prim) / sizeof(b->prim[0]));
+    const F minus_inf(-std::numeric_limits<float>::infinity());
+    for (; count != 0; --count, ++b) {
+        for (int j = 0; j < M && b->prim[j] != kNoPrim; ++j) {
+            F t(0.0f), u(0.0f), v(0.0f);  // the kernels set only their hit lanes
+            const vmask<K> m = intersect_one<TM, F, M>(*b, j, sm, r, active, s.tfar, t, u, v);
+            if (none(m)) continue;
+            if constexpr (AnyHit) {
+                s.occluded = s.occluded | m;
+                s.valid = s.valid & !m;
+                s.tfar = select(m, minus_inf, s.tfar);
+                active = active & !m;
+                if (none(active)) return;
+            } else {
+                s.hit.t = select(m, t, s.hit.t);
+                s.hit.u = select(m, u, s.hit.u);
+                s.hit.v = select(m, v, s.hit.v);
+                s.tfar = select(m, t, s.tfar);
+                for (std::uint32_t bits = mask_bits(m); bits != 0; bits &= bits - 1)
+                    s.hit.prim[std::countr_zero(bits)] = b->prim[j];
+            }
+        }
+    }
+}
+
+template <TriangleMethod TM, bool AnyHit, int N, int M, int K>
+RAYPACK_INLINE void packet_leaf(const WideBvh<N, M>& bvh, SphereMethod sm, std::uint32_t code,
+                                const LeafRay<vfloat<K>>& r, const vmask<K>& active, PacketState<K>& s) {
+    const std::uint32_t first = wide_child::first(code), count = wide_child::blocks(code);
+    switch (wide_child::kind(code)) {
+        case LeafKind::Triangle: return packet_run<TM, AnyHit>(bvh.triangles.data() + first, count, sm, r, active, s);
+        case LeafKind::Sphere: return packet_run<TM, AnyHit>(bvh.spheres.data() + first, count, sm, r, active, s);
+        case LeafKind::Cone: return packet_run<TM, AnyHit>(bvh.cones.data() + first, count, sm, r, active, s);
+        case LeafKind::Mixed: break;
+    }
+    const MixedLeaf& m = bvh.mixed[first];
+    constexpr int tri = int(LeafKind::Triangle), sph = int(LeafKind::Sphere), cone = int(LeafKind::Cone);
+    packet_run<TM, AnyHit>(bvh.triangles.data() + m.first[tri], m.count[tri], sm, r, active, s);
+    packet_run<TM, AnyHit>(bvh.spheres.data() + m.first[sph], m.count[sph], sm, r, active & s.valid, s);
+    packet_run<TM, AnyHit>(bvh.cones.data() + m.first[cone], m.count[cone], sm, r, active & s.valid, s);
+}
+
+/// The lanes `bits` as a mask.
+template <int K>
+RAYPACK_INLINE vmask<K> mask_from_bits(std::uint32_t bits) {
+    alignas(64) float f[K];
+    for (int i = 0; i < K; ++i) f[i] = (bits >> i) & 1u ? 1.0f : 0.0f;
+    return vfloat<K>::load_aligned(f) > vfloat<K>(0.0f);
+}
+
+/// The lanes `bits` finish the subtree under `root` one ray at a time
+/// (Benthin et al. 2012), each from its own closest hit so far.
+template <int N, int M, int K, TriangleMethod TM, bool AnyHit>
+void lanes_alone(const WideBvh<N, M>& bvh, SphereMethod sm, std::uint32_t root, std::uint32_t bits,
+                 const RayPacket<K>& ray, PacketState<K>& s) {
+    using F = vfloat<K>;
+    alignas(64) float org[3][K], dir[3][K], tnear[K], tfar[K], t[K], u[K], v[K];
+    for (int a = 0; a < 3; ++a) {
+        ray.org[a].store_aligned(org[a]);
+        ray.dir[a].store_aligned(dir[a]);
+    }
+    ray.tnear.store_aligned(tnear);
+    s.tfar.store_aligned(tfar);
+    s.hit.t.store_aligned(t);
+    s.hit.u.store_aligned(u);
+    s.hit.v.store_aligned(v);
+    std::uint32_t occluded = 0;
+    for (; bits != 0; bits &= bits - 1) {
+        const int i = std::countr_zero(bits);
+        Rayf r;
+        r.org = {org[0][i], org[1][i], org[2][i]};
+        r.dir = {dir[0][i], dir[1][i], dir[2][i]};
+        r.tnear = tnear[i];
+        r.tfar = tfar[i];
+        Hitf h{t[i], s.hit.prim[i], u[i], v[i]};
+        float lane_tfar = tfar[i];
+        if (!trace_wide_subtree<N, M, TM, NodeTest::Ordered, AnyHit>(
+                bvh, sm, root, make_node_ray<NodeTest::Ordered, N>(r), make_leaf_ray<vfloat<M>>(r, TM), lane_tfar, h))
+            continue;
+        if constexpr (AnyHit) {
+            occluded |= 1u << i;
+            tfar[i] = -std::numeric_limits<float>::infinity();
+        } else {
+            tfar[i] = lane_tfar;
+            t[i] = h.t;
+            u[i] = h.u;
+            v[i] = h.v;
+            s.hit.prim[i] = h.prim;
+        }
+    }
+    s.tfar = F::load_aligned(tfar);
+    if constexpr (AnyHit) {
+        if (occluded != 0) {
+            const vmask<K> m = mask_from_bits<K>(occluded);
+            s.occluded = s.occluded | m;
+            s.valid = s.valid & !m;
+        }
+    } else {
+        s.hit.t = F::load_aligned(t);
+        s.hit.u = F::load_aligned(u);
+        s.hit.v = F::load_aligned(v);
+    }
+}
+
+/// One packet through the tree.
+template <int N, int M, int K, TriangleMethod TM, bool AnyHit>
+void trace_packet(const WideBvh<N, M>& bvh, SphereMethod sm, int switch_below, const RayPacket<K>& ray,
+                  HitPacket<K>& hit, vmask<K> valid, vmask<K>& occluded) {
+    using F = vfloat<K>;
+    using B = vmask<K>;
+    const PacketNodeRay<K> nr = make_packet_node_ray<K>(ray);
+    const LeafRay<F> lr = make_packet_leaf_ray<K>(ray, TM);
+    PacketState<K> s{hit, ray.tfar, valid, occluded};
+    const WideNode<N>* nodes = bvh.nodes.data();
+    const F nan(std::numeric_limits<float>::quiet_NaN());
+    // Stack entries: a child and its lanes' entry distances, NaN in the
+    // lanes that missed it, so that `entry <= tfar` at the pop is exactly
+    // the lanes that meet it before their closest hit so far.
+    constexpr int kStackSize = (N - 1) * kBvhMaxDepth + 1;
+    alignas(64) float stack_entry[kStackSize][K];
+    std::uint32_t stack_node[kStackSize];
+    int sp = 0;
+    std::uint32_t cur = 0;
+    B active = valid;
+    for (;;) {
+        for (;;) {
+            const std::uint32_t bits = mask_bits(active);
+            if (std::popcount(bits) < switch_below) {
+                lanes_alone<N, M, K, TM, AnyHit>(bvh, sm, cur, bits, ray, s);
+                break;
+            }
+            if (wide_child::is_leaf(cur)) {
+                packet_leaf<TM, AnyHit>(bvh, sm, cur, lr, active, s);
+                break;
+            }
+            const WideNode<N>& node = nodes[cur];
+            const int first_lane = std::countr_zero(bits);
+            // Test every child against the active lanes; keep the hit ones.
+            alignas(64) float entry[N][K];
+            std::uint32_t child[N];
+            float key[N];
+            int count = 0;
+            for (int i = 0; i < N; ++i) {
+                if (node.child[i] == wide_child::kEmpty) continue;
+                F e;
+                const B m = child_hits<N, K>(node, i, nr, active, s.tfar, e);
+                const std::uint32_t mb = mask_bits(m);
+                if (mb == 0) continue;
+                select(m, e, nan).store_aligned(entry[count]);
+                child[count] = node.child[i];
+                // Order key: the first active lane's entry distance (children
+                // it misses go after the ones it meets, in slot order).
+                key[count] = (mb >> first_lane) & 1u ? entry[count][first_lane] : std::numeric_limits<float>::max();
+                ++count;
+            }
+            if (count == 0) break;
+            // Push all but the nearest, farthest first; descend into the nearest.
+            int order[N];
+            for (int c = 0; c < count; ++c) {
+                int p = c;
+                if constexpr (!AnyHit)
+                    for (; p > 0 && key[order[p - 1]] > key[c]; --p) order[p] = order[p - 1];
+                order[p] = c;
+            }
+            for (int c = count - 1; c > 0; --c) {
+                std::copy(entry[order[c]], entry[order[c]] + K, stack_entry[sp]);
+                stack_node[sp++] = child[order[c]];
+            }
+            const F e0 = F::load_aligned(entry[order[0]]);
+            active = e0 == e0;  // not NaN: the lanes that met it
+            cur = child[order[0]];
+        }
+        if constexpr (AnyHit)
+            if (none(s.valid)) return;
+        // Pop the next child some lane still meets before its closest hit.
+        for (;;) {
+            if (sp == 0) return;
+            --sp;
+            active = s.valid & (F::load_aligned(stack_entry[sp]) <= s.tfar);
+            if (any(active)) break;
+        }
+        cur = stack_node[sp];
+    }
+}
+
+}  // namespace raypack::wide_packet_detail
+
+namespace raypack {
+
+template <int N, int M, int K, bool AnyHit>
+void wide_trace_packets(const WideBvh<N, M>& bvh, KernelChoice kernels, const WidePacketConfig& config,
+                        std::span<const Rayf> rays, std::span<Hitf> hits) {
+    if (bvh.nodes.empty()) {
+        for (auto& h : hits) h = Hitf{};
+        return;
+    }
+    auto run = [&]<TriangleMethod TM>() {
+        trace_in_packets<K, AnyHit>(rays, hits, [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid,
+                                                    vmask<K>& occluded) {
+            wide_packet_detail::trace_packet<N, M, K, TM, AnyHit>(bvh, kernels.sphere, config.switch_below, ray, hit,
+                                                                  valid, occluded);
+        });
+    };
+    switch (kernels.triangle) {
+        case TriangleMethod::Moeller: return run.template operator()<TriangleMethod::Moeller>();
+        case TriangleMethod::Watertight: return run.template operator()<TriangleMethod::Watertight>();
+        case TriangleMethod::Plane: return run.template operator()<TriangleMethod::Plane>();
+    }
+}
+
+}  // namespace raypack
