@@ -67,7 +67,7 @@ struct WideCountingWalk {
                 ++counts.nodes;
                 const WideNode<N>& node = bvh.nodes[cur];
                 F entry;
-                std::uint32_t bits = node_hits<Test>(node, nr, F(tfar), entry);
+                std::uint32_t bits = node_hits<Test>(node, nr, F(node_tfar(tfar)), entry);
                 alignas(64) float dist[N];
                 entry.store_aligned(dist);
                 WideStackEntry* base = sp;
@@ -102,7 +102,7 @@ struct WideCountingWalk {
             for (;;) {
                 if (sp == stack) return found;
                 --sp;
-                if (AnyHit || sp->dist <= tfar) break;
+                if (AnyHit || sp->dist <= node_tfar(tfar)) break;
             }
             cur = sp->node;
         }

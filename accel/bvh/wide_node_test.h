@@ -57,6 +57,15 @@ struct NodeRay {
 /// zero (the float's bits + 1, whatever its sign); +-inf stays.
 inline constexpr float kFarWiden = 1.0f + 2.0f * rounding_gamma<float>(3);
 
+/// The closest-hit distance the node tests and the stack pops compare with,
+/// widened like the far planes: a hit exactly at tfar (tnear == tfar, a
+/// shadow ray that ends on a surface) must not lose its box to the rounding
+/// of the entry distance (tests/test_extremes.cpp).
+template <class F>
+RAYPACK_INLINE F node_tfar(const F& tfar) {
+    return tfar * F(kFarWiden);
+}
+
 template <NodeTest Test, int N>
 RAYPACK_INLINE NodeRay<N> make_node_ray(const Rayf& ray) {
     using F = vfloat<N>;

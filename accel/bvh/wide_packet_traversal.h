@@ -327,10 +327,11 @@ void trace_packet(const WideBvh<N, M>& bvh, SphereMethod sm, int switch_below, c
             std::uint32_t child[N];
             float key[N];
             int count = 0;
+            const F tfar_nodes = node_tfar(s.tfar);
             for (int i = 0; i < N; ++i) {
                 if (node.child[i] == wide_child::kEmpty) continue;
                 F e;
-                const B m = child_hits<N, K>(node, i, nr, active, s.tfar, e);
+                const B m = child_hits<N, K>(node, i, nr, active, tfar_nodes, e);
                 const std::uint32_t mb = mask_bits(m);
                 if (mb == 0) continue;
                 select(m, e, nan).store_aligned(entry[count]);
@@ -363,7 +364,7 @@ void trace_packet(const WideBvh<N, M>& bvh, SphereMethod sm, int switch_below, c
         for (;;) {
             if (sp == 0) return;
             --sp;
-            active = s.valid & (F::load_aligned(stack_entry[sp]) <= s.tfar);
+            active = s.valid & (F::load_aligned(stack_entry[sp]) <= node_tfar(s.tfar));
             if (any(active)) break;
         }
         cur = stack_node[sp];

@@ -128,7 +128,7 @@ RAYPACK_INLINE bool trace_wide_subtree(const WideBvh<N, M>& bvh, SphereMethod sp
     WideStackEntry stack[kStackSize];
     WideStackEntry* sp = stack;
     const WideNode<N>* nodes = bvh.nodes.data();
-    F tfar_v(tfar);
+    F tfar_v(node_tfar(tfar));
     std::uint32_t cur = root;
     bool found = false;
     for (;;) {
@@ -183,13 +183,13 @@ RAYPACK_INLINE bool trace_wide_subtree(const WideBvh<N, M>& bvh, SphereMethod sp
         if (intersect_leaf<TM, AnyHit>(bvh, sphere_method, cur, lr, tfar, hit)) {
             found = true;
             if constexpr (AnyHit) return true;
-            tfar_v = F(tfar);
+            tfar_v = F(node_tfar(tfar));
         }
     pop:
         for (;;) {
             if (sp == stack) return found;
             --sp;
-            if (AnyHit || sp->dist <= tfar) break;
+            if (AnyHit || sp->dist <= node_tfar(tfar)) break;
         }
         cur = sp->node;
     }
