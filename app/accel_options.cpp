@@ -12,7 +12,9 @@ std::vector<OptionSpec> accel_option_specs() {
 }
 
 std::string accel_options_help() {
-    return "  --accel " + accel_kinds_list() + "  acceleration structure (default bvh2)\n"
+    return "  With none of --accel, --builder, --packet: the fastest measured configuration for the rays\n"
+           "  (camera: bvh8 --packet 16, shadow: bvh4 --packet 16, diffuse: bvh8 --packet 1; README)\n"
+           "  --accel " + accel_kinds_list() + "  acceleration structure (default bvh2)\n"
            "  --builder " + bvh_builder_list() + "  BVH builder for bvh2|bvh4|bvh8 (default binned):\n"
            "                binned SAH, full-sweep SAH, Morton/LBVH, spatial splits (SBVH)\n"
            "  --sphere geometric|algebraic|precise     ray-sphere test (default geometric)\n"
@@ -45,6 +47,16 @@ AccelConfig accel_config_from(const ParsedArgs& args) {
     else if (tri == "watertight") config.kernels.triangle = TriangleMethod::Watertight;
     else throw UsageError("--triangle: expected moeller, watertight or plane, got '" + tri + "'");
     return config;
+}
+
+bool uses_fastest_config(const ParsedArgs& args) {
+    return !args.has("--accel") && !args.has("--packet") && !args.has("--builder");
+}
+
+int supported_packet(const Accel& accel, int packet) {
+    for (int w : {16, 8, 4})
+        if (w <= packet && accel.supports_packet(w)) return w;
+    return 1;
 }
 
 int packet_width_from(const ParsedArgs& args, const Accel& accel) {

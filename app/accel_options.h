@@ -13,6 +13,12 @@ AccelConfig accel_config_from(const ParsedArgs& args);
 /// --packet K, checked against what `accel` traverses natively.
 int packet_width_from(const ParsedArgs& args, const Accel& accel);
 std::string accel_options_help();
+/// True when the command line names none of --accel, --packet, --builder:
+/// trace and render then run the fastest measured configuration
+/// (app/default_config.h).
+bool uses_fastest_config(const ParsedArgs& args);
+/// `packet`, or the next narrower width `accel` traverses natively.
+int supported_packet(const Accel& accel, int packet);
 
 /// --threads T: limits oneTBB for the life of the returned object.
 class ThreadLimit {

@@ -19,6 +19,13 @@
 namespace raypack::app {
 namespace {
 
+/// The structure `kind` with every other setting at its default.
+AccelConfig config_of(const std::string& kind) {
+    AccelConfig config;
+    config.kind = kind;
+    return config;
+}
+
 constexpr std::size_t kOracleRays = 2048;   // rays checked against brute force per case
 constexpr std::size_t kCountedRays = 65536; // rays walked by the counting traversal per case
 constexpr int kPacketWidths[] = {1, 4, 8, 16};
@@ -158,7 +165,7 @@ std::size_t count_cases(const BenchPlan& plan) {
     std::size_t per_scene = 0;
     std::vector<std::string> ignored;
     for (const std::string& a : plan.accels)
-        per_scene += packet_widths(plan, *build_accel(probe, AccelConfig{.kind = a}), ignored).size();
+        per_scene += packet_widths(plan, *build_accel(probe, config_of(a)), ignored).size();
     return per_scene * plan.scenes.size() * plan.ray_kinds.size() * plan.threads.size();
 }
 
@@ -190,7 +197,7 @@ int run_bench(const Args& args) {
             samples.push_back(oracle_sample(scene, sets.back(), kOracleRays));
         }
         for (const std::string& accel_kind : plan.accels) {
-            const auto accel = build_accel(scene, AccelConfig{.kind = accel_kind});
+            const auto accel = build_accel(scene, config_of(accel_kind));
             const AccelStats& stats = accel->stats();
             const std::vector<int> widths = packet_widths(plan, *accel, skipped);
             for (std::size_t s = 0; s < sets.size(); ++s) {
@@ -207,11 +214,12 @@ int run_bench(const Args& args) {
                     for (int threads : plan.threads) {
                         progress.next(context + " " + std::to_string(threads) + " thread" + (threads > 1 ? "s" : ""));
                         const ThreadLimit limit(threads);
-                        BenchRow row{.scene = scene_name, .scene_file = scene_spec, .accel = stats.name,
-                                     .builder = stats.builder, .packet = packet, .rays = set.name,
-                                     .any_hit = set.any_hit, .ray_count = set.rays.size(), .threads = threads,
-                                     .repeat = plan.repeat, .build_ms = stats.build_ms, .memory_bytes = stats.bytes,
-                                     .sah_cost = stats.sah_cost};
+                        BenchRow row;
+                        row.scene = scene_name, row.scene_file = scene_spec, row.accel = stats.name;
+                        row.builder = stats.builder, row.packet = packet, row.rays = set.name;
+                        row.any_hit = set.any_hit, row.ray_count = set.rays.size(), row.threads = threads;
+                        row.repeat = plan.repeat, row.build_ms = stats.build_ms, row.memory_bytes = stats.bytes;
+                        row.sah_cost = stats.sah_cost;
                         const std::vector<double> ms = time_passes(*accel, packet, set, plan.repeat, row.hits);
                         // Mrays/s of each pass: the fastest pass is the max.
                         const double mrays = double(set.rays.size()) / 1e3;

@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "app/accel_options.h"
+#include "app/default_config.h"
 #include "app/commands.h"
 #include "render/cost_map.h"
 #include "render/whitted.h"
@@ -64,7 +65,10 @@ int run_render(const Args& args) {
         return 0;
     }
     const std::string scene_spec = p.positional()[0];
-    const AccelConfig config = accel_config_from(p);
+    AccelConfig config = accel_config_from(p);
+    // Eye rays are camera rays: with no structure named, the fastest for them.
+    const bool fastest = uses_fastest_config(p);
+    if (fastest) config.kind = fastest_config(RayWorkload::Camera).accel;
     WhittedOptions options;
     options.max_depth = int(p.integer("--depth", 5, 1, 64));
     const ThreadLimit limit(int(p.integer("--threads", 0, 1, 1024)));
@@ -82,7 +86,8 @@ int run_render(const Args& args) {
 
     const auto accel = build_accel(scene, config);
     if (aov == "cost") return render_cost(scene, *accel, options.width, options.height, output);
-    options.packet = packet_width_from(p, *accel);
+    options.packet = fastest ? supported_packet(*accel, fastest_config(RayWorkload::Camera).packet)
+                             : packet_width_from(p, *accel);
     Image image;
     const RenderStats stats = render_whitted(scene, *accel, options, image);
     t0 = std::chrono::steady_clock::now();

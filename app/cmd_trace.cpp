@@ -10,6 +10,7 @@
 
 #include "app/accel_options.h"
 #include "app/commands.h"
+#include "app/default_config.h"
 #include "scene/load.h"
 #include "scene/ray_file.h"
 
@@ -61,14 +62,17 @@ int run_trace(const Args& args) {
         return 0;
     }
     if (!p.has("--rays")) throw UsageError("missing --rays FILE.rays");
-    const AccelConfig config = accel_config_from(p);
+    AccelConfig config = accel_config_from(p);
     const int repeat = int(p.integer("--repeat", 5, 1, 100000));
     const ThreadLimit limit(int(p.integer("--threads", 0, 1, 1024)));
 
     const Scene scene = load_scene(p.positional()[0]);
     const RayFile file = read_rays(p.text("--rays"));
+    const RayWorkload workload = classify_workload(file.rays, file.kind == RayKind::AnyHit);
+    const bool fastest = uses_fastest_config(p);
+    if (fastest) config.kind = fastest_config(workload).accel;
     const auto accel = build_accel(scene, config);
-    const int packet = packet_width_from(p, *accel);
+    const int packet = fastest ? supported_packet(*accel, fastest_config(workload).packet) : packet_width_from(p, *accel);
     std::vector<Hitf> hits(file.rays.size());
     trace_all(*accel, packet, file, hits);  // warm-up, untimed
     std::vector<double> times;
@@ -90,6 +94,8 @@ int run_trace(const Args& args) {
         j["accel"] = as.name;
         j["builder"] = as.builder;
         j["packet"] = packet;
+        j["default_config"] = fastest;  // chosen by the measured table, not the command line
+        j["workload"] = workload_name(workload);
         j["kind"] = file.kind == RayKind::ClosestHit ? "closest" : "any";
         j["rays"] = file.rays.size();
         j["threads"] = limit.threads();
@@ -116,6 +122,9 @@ int run_trace(const Args& args) {
         std::printf("  packets of %d, %d threads, %d passes: median %.2f ms (min %.2f, max %.2f), %.2f Mrays/s; %zu %s\n",
                     packet, limit.threads(), repeat, median, sorted.front(), sorted.back(), mrays, hit_count,
                     file.kind == RayKind::ClosestHit ? "hits" : "occluded");
+        if (fastest)
+            std::printf("  (%s rays: the fastest measured configuration; --accel/--packet/--builder choose another)\n",
+                        workload_name(workload));
     }
     return 0;
 }

@@ -101,6 +101,40 @@ TEST(Cli, TraceAnswersClosestAndAnyHitWithJson) {
     }
 }
 
+/// With no structure, builder or width named, trace runs the fastest measured
+/// configuration for the kind of rays (app/default_config.cpp, the README's
+/// table) and says so in --json; naming any of them turns that off.
+TEST(Cli, TraceDefaultsToTheFastestConfigurationForTheRays) {
+    const fs::path dir = temp_dir();
+    const std::string scene = "gen:balls:2";
+    struct Case {
+        const char* kind;
+        const char* workload;
+        const char* accel;
+        int packet;
+    };
+    for (const Case& c : {Case{"camera", "camera", "bvh8", 16}, Case{"shadow", "shadow", "bvh4", 16},
+                          Case{"diffuse", "diffuse", "bvh8", 1}}) {
+        const std::string rays = (dir / (std::string("default_") + c.kind + ".rays")).string();
+        ASSERT_EQ(run("rays " + scene + " --kind " + c.kind + " --res 32 32 -o " + rays).status, 0);
+        const Result r = run("trace " + scene + " --rays " + rays + " --repeat 1 --json");
+        ASSERT_EQ(r.status, 0) << r.output;
+        const auto j = nlohmann::json::parse(r.output);
+        EXPECT_TRUE(j["default_config"].get<bool>()) << c.kind;
+        EXPECT_EQ(j["workload"], c.workload);
+        EXPECT_EQ(j["accel"], c.accel) << c.kind;
+#if defined(__AVX512BW__)
+        EXPECT_EQ(j["packet"].get<int>(), c.packet) << c.kind;
+#endif
+        const Result named = run("trace " + scene + " --rays " + rays + " --repeat 1 --json --accel bvh2");
+        ASSERT_EQ(named.status, 0) << named.output;
+        const auto jn = nlohmann::json::parse(named.output);
+        EXPECT_FALSE(jn["default_config"].get<bool>());
+        EXPECT_EQ(jn["accel"], "bvh2");
+        EXPECT_EQ(jn["packet"].get<int>(), 1);
+    }
+}
+
 TEST(Cli, BadFlagsAreUsageErrors) {
     struct Case {
         std::string args, phrase;

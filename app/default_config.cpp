@@ -1,0 +1,43 @@
+#include "app/default_config.h"
+
+#include <algorithm>
+
+#include "kernels/simd.h"
+
+namespace raypack::app {
+
+const char* workload_name(RayWorkload workload) {
+    switch (workload) {
+        case RayWorkload::Camera: return "camera";
+        case RayWorkload::Shadow: return "shadow";
+        case RayWorkload::Diffuse: return "diffuse";
+    }
+    return "camera";
+}
+
+RayWorkload classify_workload(std::span<const Rayf> rays, bool any_hit) {
+    if (any_hit) return RayWorkload::Shadow;
+    if (rays.empty()) return RayWorkload::Camera;
+    const Vec3f o = rays.front().org;
+    const bool one_origin = std::all_of(rays.begin(), rays.end(), [&](const Rayf& r) {
+        return r.org.x == o.x && r.org.y == o.y && r.org.z == o.z;
+    });
+    return one_origin ? RayWorkload::Camera : RayWorkload::Diffuse;
+}
+
+TraceConfig fastest_config(RayWorkload workload) {
+    // From the README's table (one thread, 1024 x 1024, geometric mean over
+    // balls, mount, tetra, teapot and the bunny): wide BVHs with packets of 16
+    // for coherent camera and shadow rays; one ray at a time over the BVH8 for
+    // incoherent diffuse rays, where packets break up after the first bounce.
+    TraceConfig c{"bvh8", 16};
+    switch (workload) {
+        case RayWorkload::Camera: c = {"bvh8", 16}; break;
+        case RayWorkload::Shadow: c = {"bvh4", 16}; break;
+        case RayWorkload::Diffuse: c = {"bvh8", 1}; break;
+    }
+    if (c.packet == 16 && !kWidthCompiled<16>) c.packet = 8;
+    return c;
+}
+
+}  // namespace raypack::app
