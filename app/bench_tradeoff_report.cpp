@@ -54,6 +54,7 @@ Json to_json(const TradeoffRow& r) {
         const std::string label = placement_label(placements[i]);
         j["self_shadow_rays_" + label] = self ? Json(r.self[i].shadow_rays) : Json();
         j["self_shadow_hits_" + label] = self ? Json(r.self[i].shadow_self) : Json();
+        j["shadow_wrong_" + label] = self ? Json(r.self[i].shadow_wrong) : Json();
         j["self_reflect_rays_" + label] = self ? Json(r.self[i].reflect_rays) : Json();
         j["self_reflect_hits_" + label] = self ? Json(r.self[i].reflect_self) : Json();
     }
@@ -122,7 +123,8 @@ void print_tradeoff_table(std::FILE* out, const std::vector<TradeoffRow>& rows) 
     for (const TradeoffRow& r : rows) {
         if (r.self.empty()) continue;
         if (!header) {
-            std::fprintf(out, "\nself-intersections (shadow + reflection rays that found the object they left):\n%-18s",
+            std::fprintf(out, "\nself-intersections (shadow + reflection rays that found the object they left), and shadow\n"
+                         "rays whose answer differs from the reference traced from the hit point itself:\n%-18s",
                          "");
             for (const Placement& p : self_intersection_placements()) std::fprintf(out, " %14s", placement_label(p).c_str());
             std::fprintf(out, "\n");
@@ -130,6 +132,9 @@ void print_tradeoff_table(std::FILE* out, const std::vector<TradeoffRow>& rows) 
         }
         std::fprintf(out, "%-18s", (r.family + " " + r.variant).c_str());
         for (const SelfIntersections& s : r.self) std::fprintf(out, " %14s", fraction_text(s.self(), s.rays()).c_str());
+        std::fprintf(out, "\n%-18s", "  wrong shadows");
+        for (const SelfIntersections& s : r.self)
+            std::fprintf(out, " %14s", fraction_text(s.shadow_wrong, s.shadow_rays).c_str());
         std::fprintf(out, "\n");
     }
 }

@@ -322,7 +322,7 @@ SelfIntersections count_self_intersections(const ObjectScene& objects, const Acc
     accel.intersect(camera, hits);
     const RayOffset offset(policy, scene);
     const Vec3f light = scene.lights.empty() ? Vec3f{} : scene.lights.front().position;
-    std::vector<Rayf> shadow, reflect;
+    std::vector<Rayf> shadow, reflect, shadow_reference;
     std::vector<std::uint32_t> shadow_from, reflect_from;
     for (std::size_t i = 0; i < camera.size(); ++i) {
         if (!hits[i].found()) continue;
@@ -345,23 +345,52 @@ SelfIntersections count_self_intersections(const ObjectScene& objects, const Acc
             r.tfar = 1.0f - 1e-6f;
             shadow.push_back(r);
             shadow_from.push_back(object);
+            Rayf exact;
+            exact.org = accurate_hit_point(scene, camera[i], hits[i]);
+            exact.dir = light - exact.org;
+            exact.tfar = r.tfar;
+            shadow_reference.push_back(exact);
         }
     }
-    auto count_self = [&](const std::vector<Rayf>& rays, const std::vector<std::uint32_t>& from) {
+    auto closest = [&](const std::vector<Rayf>& rays) {
         std::vector<Hitf> h(rays.size());
         tbb::parallel_for(std::size_t(0), rays.size(), kBlock, [&](std::size_t b) {
             const std::size_t n = std::min(kBlock, rays.size() - b);
             accel.intersect({rays.data() + b, n}, {h.data() + b, n});
         });
+        return h;
+    };
+    auto count_self = [&](const std::vector<Hitf>& h, const std::vector<std::uint32_t>& from) {
         std::uint64_t self = 0;
-        for (std::size_t i = 0; i < rays.size(); ++i) self += h[i].found() && objects.object[h[i].prim] == from[i];
+        for (std::size_t i = 0; i < h.size(); ++i) self += h[i].found() && objects.object[h[i].prim] == from[i];
         return self;
     };
     SelfIntersections out;
+    const std::vector<Hitf> shadow_hits = closest(shadow);
     out.shadow_rays = shadow.size();
-    out.shadow_self = count_self(shadow, shadow_from);
+    out.shadow_self = count_self(shadow_hits, shadow_from);
     out.reflect_rays = reflect.size();
-    out.reflect_self = count_self(reflect, reflect_from);
+    out.reflect_self = count_self(closest(reflect), reflect_from);
+    // The reference: step past the object left (a convex object meets a ray
+    // leaving it outward only at its origin, up to rounding).
+    std::vector<Hitf> reference = closest(shadow_reference);
+    for (int step = 0; step < 4; ++step) {
+        std::vector<std::size_t> again;
+        for (std::size_t i = 0; i < reference.size(); ++i)
+            if (reference[i].found() && objects.object[reference[i].prim] == shadow_from[i]) again.push_back(i);
+        if (again.empty()) break;
+        std::vector<Rayf> rays;
+        for (std::size_t i : again) {
+            rays.push_back(shadow_reference[i]);
+            rays.back().tnear = std::nextafter(reference[i].t, std::numeric_limits<float>::infinity());
+        }
+        const std::vector<Hitf> next = closest(rays);
+        for (std::size_t k = 0; k < again.size(); ++k) reference[again[k]] = next[k];
+    }
+    for (std::size_t i = 0; i < shadow.size(); ++i) {
+        const bool reference_occluded = reference[i].found() && objects.object[reference[i].prim] != shadow_from[i];
+        out.shadow_wrong += shadow_hits[i].found() != reference_occluded;
+    }
     return out;
 }
 

@@ -62,6 +62,10 @@ UlpError t_error_ulps(const Scene& scene, PrimKind kind, KernelChoice kernels, s
 /// Secondary rays that found the object they left.
 struct SelfIntersections {
     std::uint64_t shadow_rays = 0, shadow_self = 0;
+    /// Shadow rays whose answer (occluded or not) differs from the reference:
+    /// from the hit point itself, every primitive but those of the object left.
+    /// Counts self-intersections and also offsets that jump past an occluder.
+    std::uint64_t shadow_wrong = 0;
     std::uint64_t reflect_rays = 0, reflect_self = 0;
     std::uint64_t rays() const { return shadow_rays + reflect_rays; }
     std::uint64_t self() const { return shadow_self + reflect_self; }
@@ -73,6 +77,8 @@ struct SelfIntersections {
 /// reflection about the geometric normal, both leaving by `policy`. Both
 /// point away from a convex object, so finding any primitive of the same
 /// object (closest hit, shadow rays up to the light) is a self-intersection.
+/// The reference shadow answer is traced from the accurate hit point with no
+/// offset by `accel`, stepping past hits on the object left (at most 4).
 SelfIntersections count_self_intersections(const ObjectScene& scene, const Accel& accel, OffsetPolicy policy,
                                            int width, int height);
 

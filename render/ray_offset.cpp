@@ -64,7 +64,9 @@ Vec3f accurate_hit_point(const Scene& scene, const Rayf& ray, const Hitf& hit) {
     switch (ref.kind) {
         case PrimKind::Triangle: {
             const TriangleSoA& t = scene.triangles;
-            return t.p0[i] * (1.0f - hit.u - hit.v) + t.p1[i] * hit.u + t.p2[i] * hit.v;
+            // From p0 along the edges: the small products carry small errors
+            // and only the last sum rounds at the magnitude of the point.
+            return t.p0[i] + ((t.p1[i] - t.p0[i]) * hit.u + (t.p2[i] - t.p0[i]) * hit.v);
         }
         case PrimKind::Sphere: {
             const Vec3f c = scene.spheres.center[i];
