@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <functional>
 #include <cstdio>
 
+#include "app/accel_options.h"
 #include "app/bench_measure.h"
 #include "app/bench_tradeoff_report.h"
 #include "render/camera_rays.h"
@@ -50,6 +52,27 @@ void set_throughput(TradeoffRow& row, std::size_t rays, const std::vector<double
     row.mrays_per_s_median = krays / std::max(1e-9, median(ms));
     row.mrays_per_s_min = krays / std::max(1e-9, *std::max_element(ms.begin(), ms.end()));
     row.mrays_per_s_max = krays / std::max(1e-9, *std::min_element(ms.begin(), ms.end()));
+}
+
+/// Milliseconds of `repeat` passes of each variant, taken in turns (pass 1
+/// of every variant, then pass 2, ...) after one warm-up pass each, so that
+/// the load of a shared machine falls on all variants alike and their
+/// ratios hold within one run. One thread: figures per core.
+std::vector<std::vector<double>> interleaved_passes(const std::vector<std::function<double()>>& variants, int repeat) {
+    const ThreadLimit one_thread(1);
+    std::vector<std::vector<double>> ms(variants.size());
+    for (int pass = -1; pass < repeat; ++pass)
+        for (std::size_t v = 0; v < variants.size(); ++v) {
+            const double t = variants[v]();
+            if (pass >= 0) ms[v].push_back(t);
+        }
+    return ms;
+}
+
+/// One pass over `set` (closest hit), in milliseconds.
+double time_one_pass(const Accel& accel, const BenchRays& set) {
+    std::size_t hits = 0;
+    return time_passes(accel, 1, set, 1, hits).back();
 }
 
 class Stages {
@@ -109,20 +132,27 @@ void run_triangle_family(const TradeoffPlan& plan, const TradeoffSizes& sizes, c
     const WhittedOptions options = image_options(sizes.image_res, kDefaultOffset);
     stages.note("triangle: double reference render of " + std::string(kTriangleScene));
     const Image reference = render_double_reference(scene, options);
-    for (const auto& [name, method] : {std::pair{"moeller", TriangleMethod::Moeller},
-                                       std::pair{"watertight", TriangleMethod::Watertight},
-                                       std::pair{"plane", TriangleMethod::Plane}}) {
+    const std::pair<const char*, TriangleMethod> variants[] = {
+        {"moeller", TriangleMethod::Moeller}, {"watertight", TriangleMethod::Watertight}, {"plane", TriangleMethod::Plane}};
+    std::vector<std::unique_ptr<Accel>> accels;
+    std::vector<std::function<double()>> passes;
+    for (const auto& [name, method] : variants) {
+        accels.push_back(build_accel(scene, AccelConfig{.kind = "bvh2", .kernels = KernelChoice{.triangle = method}}));
+        passes.push_back([&camera, &accel = *accels.back()] { return time_one_pass(accel, camera); });
+    }
+    stages.note("triangle: timing the variants in turns");
+    const auto ms = interleaved_passes(passes, plan.repeat);
+    for (std::size_t v = 0; v < std::size(variants); ++v) {
+        const auto& [name, method] = variants[v];
         stages.note(std::string("triangle ") + name);
         const AccelConfig config{.kind = "bvh2", .kernels = KernelChoice{.triangle = method}};
         TradeoffRow row{.family = "triangle", .variant = name, .throughput_scene = kTriangleScene,
                         .throughput_rays = "camera"};
-        const auto accel = build_accel(scene, config);
-        std::size_t hits = 0;
-        set_throughput(row, camera.rays.size(), time_passes(*accel, 1, camera, plan.repeat, hits));
+        set_throughput(row, camera.rays.size(), ms[v]);
         row.leaks = count_mesh_leaks(meshes, *build_accel(meshes.scene, config), sizes.leak_rays);
         row.t_ulps = pooled_ulps(ulp, PrimKind::Triangle, config.kernels, sizes.ulp_rays);
         Image image;
-        render_whitted(scene, *accel, options, image);
+        render_whitted(scene, *accels[v], options, image);
         row.image = image_error(image, reference);
         row.image_scene = kTriangleScene;
         row.image_width = row.image_height = sizes.image_res;
@@ -139,16 +169,23 @@ void run_sphere_family(const TradeoffPlan& plan, const TradeoffSizes& sizes, con
     const WhittedOptions options = image_options(sizes.image_res, kDefaultOffset);
     stages.note("sphere: double reference render of " + std::string(kSphereImageScene));
     const Image reference = render_double_reference(image_scene, options);
-    for (const auto& [name, method] : {std::pair{"algebraic", SphereMethod::Algebraic},
-                                       std::pair{"geometric", SphereMethod::Geometric},
-                                       std::pair{"precise", SphereMethod::Precise}}) {
+    const std::pair<const char*, SphereMethod> variants[] = {
+        {"algebraic", SphereMethod::Algebraic}, {"geometric", SphereMethod::Geometric}, {"precise", SphereMethod::Precise}};
+    std::vector<std::unique_ptr<Accel>> accels;
+    std::vector<std::function<double()>> passes;
+    for (const auto& [name, method] : variants) {
+        accels.push_back(build_accel(timing_scene, AccelConfig{.kind = "bvh2", .kernels = KernelChoice{.sphere = method}}));
+        passes.push_back([&camera, &accel = *accels.back()] { return time_one_pass(accel, camera); });
+    }
+    stages.note("sphere: timing the variants in turns");
+    const auto ms = interleaved_passes(passes, plan.repeat);
+    for (std::size_t v = 0; v < std::size(variants); ++v) {
+        const auto& [name, method] = variants[v];
         stages.note(std::string("sphere ") + name);
         const AccelConfig config{.kind = "bvh2", .kernels = KernelChoice{.sphere = method}};
         TradeoffRow row{.family = "sphere", .variant = name, .throughput_scene = kSphereTimingScene,
                         .throughput_rays = "camera"};
-        std::size_t hits = 0;
-        set_throughput(row, camera.rays.size(),
-                       time_passes(*build_accel(timing_scene, config), 1, camera, plan.repeat, hits));
+        set_throughput(row, camera.rays.size(), ms[v]);
         row.leaks = count_sphere_leaks(spheres, *build_accel(spheres.scene, config), sizes.leak_rays);
         row.t_ulps = pooled_ulps(ulp, PrimKind::Sphere, config.kernels, sizes.ulp_rays);
         Image image;
@@ -208,19 +245,24 @@ void run_offset_family(const TradeoffPlan& plan, const TradeoffSizes& sizes, con
     }
     stages.note("offset: double reference render of " + std::string(kSphereImageScene) + " (robust offset)");
     const Image reference = render_double_reference(image_scene, image_options(sizes.image_res, OffsetPolicy::Robust));
-    for (OffsetPolicy policy : {OffsetPolicy::Epsilon, OffsetPolicy::Scaled, OffsetPolicy::Robust}) {
+    const OffsetPolicy policies[] = {OffsetPolicy::Epsilon, OffsetPolicy::Scaled, OffsetPolicy::Robust};
+    std::vector<Rayf> shadow(camera.size());
+    std::vector<std::uint8_t> occluded(camera.size());
+    std::vector<RayOffset> offsets;
+    for (OffsetPolicy policy : policies) offsets.emplace_back(policy, timing_scene);
+    std::vector<std::function<double()>> passes;
+    for (const RayOffset& offset : offsets)
+        passes.push_back([&, &offset = offset] {
+            return time_shadow_pass(timing_scene, *timing_accel, offset, camera, hits, shadow, occluded);
+        });
+    stages.note("offset: timing the policies in turns");
+    const auto ms = interleaved_passes(passes, plan.repeat);
+    for (std::size_t v = 0; v < std::size(policies); ++v) {
+        const OffsetPolicy policy = policies[v];
         stages.note(std::string("offset ") + offset_policy_name(policy));
         TradeoffRow row{.family = "offset", .variant = offset_policy_name(policy),
                         .throughput_scene = kSphereTimingScene, .throughput_rays = "shadow"};
-        const RayOffset offset(policy, timing_scene);
-        std::vector<Rayf> shadow(camera.size());
-        std::vector<std::uint8_t> occluded(camera.size());
-        std::vector<double> ms;
-        for (int pass = -1; pass < plan.repeat; ++pass) {  // pass -1: the warm-up
-            const double t = time_shadow_pass(timing_scene, *timing_accel, offset, camera, hits, shadow, occluded);
-            if (pass >= 0) ms.push_back(t);
-        }
-        set_throughput(row, camera.size(), ms);
+        set_throughput(row, camera.size(), ms[v]);
         for (std::size_t i = 0; i < placed.size(); ++i)
             row.self.push_back(count_self_intersections(placed[i], *placed_accels[i], policy, sizes.self_res,
                                                         sizes.self_res));

@@ -8,7 +8,7 @@ namespace raypack::app {
 
 struct TradeoffPlan {
     bool quick = false;  ///< small inputs: every family in well under two minutes
-    int repeat = 5;      ///< timed passes per throughput figure (median reported)
+    int repeat = 9;      ///< timed passes per throughput figure (median reported), one thread
     std::string json, csv;
 };
 

@@ -189,7 +189,7 @@ int run_bench(const Args& args) {
             if (p.has(other)) throw UsageError(std::string(other) + " does not apply to --tradeoff (it runs every variant)");
         if (!p.positional().empty()) throw UsageError("--tradeoff takes no SCENE (it builds its own)");
         return run_tradeoff(TradeoffPlan{.quick = p.has("--quick"),
-                                         .repeat = int(p.integer("--repeat", p.has("--quick") ? 3 : 5, 1, 1000)),
+                                         .repeat = int(p.integer("--repeat", p.has("--quick") ? 3 : 9, 1, 1000)),
                                          .json = p.text("--json"), .csv = p.text("--csv")});
     }
     const BenchPlan plan = plan_from(p);
