@@ -123,75 +123,49 @@ WhittedOptions image_options(int res, OffsetPolicy offset) {
     return o;
 }
 
-void run_triangle_family(const TradeoffPlan& plan, const TradeoffSizes& sizes, const Stages& stages,
-                         std::vector<TradeoffRow>& rows) {
-    const Scene scene = load_scene(kTriangleScene);
-    const BenchRays camera = make_bench_rays(scene, "camera", sizes.timing_res, sizes.timing_res);
-    const ObjectScene meshes = leak_test_meshes(sizes.mesh_detail, sizes.tetra_size);
-    const std::vector<ObjectScene> ulp = ulp_scenes();
-    const WhittedOptions options = image_options(sizes.image_res, kDefaultOffset);
-    stages.note("triangle: double reference render of " + std::string(kTriangleScene));
-    const Image reference = render_double_reference(scene, options);
-    const std::pair<const char*, TriangleMethod> variants[] = {
-        {"moeller", TriangleMethod::Moeller}, {"watertight", TriangleMethod::Watertight}, {"plane", TriangleMethod::Plane}};
-    std::vector<std::unique_ptr<Accel>> accels;
-    std::vector<std::function<double()>> passes;
-    for (const auto& [name, method] : variants) {
-        accels.push_back(build_accel(scene, AccelConfig{.kind = "bvh2", .kernels = KernelChoice{.triangle = method}}));
-        passes.push_back([&camera, &accel = *accels.back()] { return time_one_pass(accel, camera); });
-    }
-    stages.note("triangle: timing the variants in turns");
-    const auto ms = interleaved_passes(passes, plan.repeat);
-    for (std::size_t v = 0; v < std::size(variants); ++v) {
-        const auto& [name, method] = variants[v];
-        stages.note(std::string("triangle ") + name);
-        const AccelConfig config{.kind = "bvh2", .kernels = KernelChoice{.triangle = method}};
-        TradeoffRow row{.family = "triangle", .variant = name, .throughput_scene = kTriangleScene,
-                        .throughput_rays = "camera"};
-        set_throughput(row, camera.rays.size(), ms[v]);
-        row.leaks = count_mesh_leaks(meshes, *build_accel(meshes.scene, config), sizes.leak_rays);
-        row.t_ulps = pooled_ulps(ulp, PrimKind::Triangle, config.kernels, sizes.ulp_rays);
-        Image image;
-        render_whitted(scene, *accels[v], options, image);
-        row.image = image_error(image, reference);
-        row.image_scene = kTriangleScene;
-        row.image_width = row.image_height = sizes.image_res;
-        rows.push_back(std::move(row));
-    }
-}
+/// A family of primitive tests: its variants, where each is timed and
+/// rendered, and how its leaks are counted.
+struct KernelFamily {
+    const char* name;
+    PrimKind kind;
+    const char* timing_scene;
+    const char* image_scene;
+    std::vector<std::pair<const char*, KernelChoice>> variants;
+    ObjectScene leak_scene;
+    LeakCounts (*count_leaks)(const ObjectScene&, const Accel&, std::uint64_t, std::uint64_t);
+};
 
-void run_sphere_family(const TradeoffPlan& plan, const TradeoffSizes& sizes, const Stages& stages,
-                       std::vector<TradeoffRow>& rows) {
-    const Scene timing_scene = load_scene(kSphereTimingScene), image_scene = load_scene(kSphereImageScene);
+void run_kernel_family(const KernelFamily& family, const TradeoffPlan& plan, const TradeoffSizes& sizes,
+                       const Stages& stages, std::vector<TradeoffRow>& rows) {
+    const std::string name = family.name;
+    const Scene timing_scene = load_scene(family.timing_scene), image_scene = load_scene(family.image_scene);
     const BenchRays camera = make_bench_rays(timing_scene, "camera", sizes.timing_res, sizes.timing_res);
-    const ObjectScene spheres = leak_test_spheres();
     const std::vector<ObjectScene> ulp = ulp_scenes();
     const WhittedOptions options = image_options(sizes.image_res, kDefaultOffset);
-    stages.note("sphere: double reference render of " + std::string(kSphereImageScene));
+    stages.note(name + ": double reference render of " + family.image_scene);
     const Image reference = render_double_reference(image_scene, options);
-    const std::pair<const char*, SphereMethod> variants[] = {
-        {"algebraic", SphereMethod::Algebraic}, {"geometric", SphereMethod::Geometric}, {"precise", SphereMethod::Precise}};
     std::vector<std::unique_ptr<Accel>> accels;
     std::vector<std::function<double()>> passes;
-    for (const auto& [name, method] : variants) {
-        accels.push_back(build_accel(timing_scene, AccelConfig{.kind = "bvh2", .kernels = KernelChoice{.sphere = method}}));
+    for (const auto& [variant, kernels] : family.variants) {
+        accels.push_back(build_accel(timing_scene, AccelConfig{.kind = "bvh2", .kernels = kernels}));
         passes.push_back([&camera, &accel = *accels.back()] { return time_one_pass(accel, camera); });
     }
-    stages.note("sphere: timing the variants in turns");
+    stages.note(name + ": timing the variants in turns");
     const auto ms = interleaved_passes(passes, plan.repeat);
-    for (std::size_t v = 0; v < std::size(variants); ++v) {
-        const auto& [name, method] = variants[v];
-        stages.note(std::string("sphere ") + name);
-        const AccelConfig config{.kind = "bvh2", .kernels = KernelChoice{.sphere = method}};
-        TradeoffRow row{.family = "sphere", .variant = name, .throughput_scene = kSphereTimingScene,
+    for (std::size_t v = 0; v < family.variants.size(); ++v) {
+        const auto& [variant, kernels] = family.variants[v];
+        stages.note(name + " " + variant);
+        const AccelConfig config{.kind = "bvh2", .kernels = kernels};
+        TradeoffRow row{.family = name, .variant = variant, .throughput_scene = family.timing_scene,
                         .throughput_rays = "camera"};
         set_throughput(row, camera.rays.size(), ms[v]);
-        row.leaks = count_sphere_leaks(spheres, *build_accel(spheres.scene, config), sizes.leak_rays);
-        row.t_ulps = pooled_ulps(ulp, PrimKind::Sphere, config.kernels, sizes.ulp_rays);
+        row.leaks = family.count_leaks(family.leak_scene, *build_accel(family.leak_scene.scene, config),
+                                       sizes.leak_rays, 1);
+        row.t_ulps = pooled_ulps(ulp, family.kind, kernels, sizes.ulp_rays);
         Image image;
         render_whitted(image_scene, *build_accel(image_scene, config), options, image);
         row.image = image_error(image, reference);
-        row.image_scene = kSphereImageScene;
+        row.image_scene = family.image_scene;
         row.image_width = row.image_height = sizes.image_res;
         rows.push_back(std::move(row));
     }
@@ -281,8 +255,22 @@ int run_tradeoff(const TradeoffPlan& plan) {
     const TradeoffSizes sizes = sizes_for(plan.quick);
     const Stages stages;
     std::vector<TradeoffRow> rows;
-    run_triangle_family(plan, sizes, stages, rows);
-    run_sphere_family(plan, sizes, stages, rows);
+    run_kernel_family({.name = "triangle", .kind = PrimKind::Triangle, .timing_scene = kTriangleScene,
+                       .image_scene = kTriangleScene,
+                       .variants = {{"moeller", {.triangle = TriangleMethod::Moeller}},
+                                    {"watertight", {.triangle = TriangleMethod::Watertight}},
+                                    {"plane", {.triangle = TriangleMethod::Plane}}},
+                       .leak_scene = leak_test_meshes(sizes.mesh_detail, sizes.tetra_size),
+                       .count_leaks = count_mesh_leaks},
+                      plan, sizes, stages, rows);
+    run_kernel_family({.name = "sphere", .kind = PrimKind::Sphere, .timing_scene = kSphereTimingScene,
+                       .image_scene = kSphereImageScene,
+                       .variants = {{"algebraic", {.sphere = SphereMethod::Algebraic}},
+                                    {"geometric", {.sphere = SphereMethod::Geometric}},
+                                    {"precise", {.sphere = SphereMethod::Precise}}},
+                       .leak_scene = leak_test_spheres(),
+                       .count_leaks = count_sphere_leaks},
+                      plan, sizes, stages, rows);
     run_offset_family(plan, sizes, stages, rows);
     print_tradeoff_table(stdout, rows);
     std::printf("not measured (no such variant on this branch): --slabs, --rcp, --precision, --builder\n");
