@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "accel/accel.h"
+#include "render/ray_offset.h"
 #include "scene/scene.h"
 
 namespace raypack::app {
@@ -17,8 +18,10 @@ struct BenchRays {
     std::vector<Rayf> rays;
 };
 
-/// The standard sets of render/ray_sets.h at w x h (diffuse: seed 1).
-BenchRays make_bench_rays(const Scene& scene, const std::string& kind, int width, int height);
+/// The standard sets of render/ray_sets.h at w x h (diffuse: seed 1), secondary
+/// origins moved off the surface by `offset`.
+BenchRays make_bench_rays(const Scene& scene, const std::string& kind, int width, int height,
+                          OffsetPolicy offset = kDefaultOffset);
 /// A docs/rays.md file; throws naming the file when it cannot be read.
 BenchRays load_bench_rays(const std::string& path);
 

@@ -1,11 +1,9 @@
 #include "app/bench_report.h"
 
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <stdexcept>
 
-#include "scene/atomic_file.h"
+#include "app/json_table.h"
 
 namespace raypack::app {
 namespace {
@@ -52,21 +50,6 @@ nlohmann::ordered_json to_json(const BenchRow& r) {
     return j;
 }
 
-void write_text(const std::string& path, const std::string& text) {
-    write_atomically(path, [&](const std::string& tmp) {
-        std::ofstream out(tmp, std::ios::binary);
-        out << text;
-        out.close();
-        if (!out) throw std::runtime_error("cannot write " + path);
-    });
-}
-
-std::string csv_field(const nlohmann::ordered_json& v) {
-    if (v.is_null()) return "";
-    if (v.is_string()) return v.get<std::string>();  // names hold no commas or quotes
-    return v.dump();
-}
-
 }  // namespace
 
 void print_bench_header(std::FILE* out) {
@@ -84,30 +67,15 @@ void print_bench_row(std::FILE* out, const BenchRow& r) {
 }
 
 void write_bench_json(const std::string& path, const std::vector<BenchRow>& rows) {
-    nlohmann::ordered_json array = nlohmann::ordered_json::array();
-    for (const BenchRow& r : rows) array.push_back(to_json(r));
-    write_text(path, array.dump(2) + "\n");
+    std::vector<nlohmann::ordered_json> objects;
+    for (const BenchRow& r : rows) objects.push_back(to_json(r));
+    write_json_rows(path, objects);
 }
 
 void write_bench_csv(const std::string& path, const std::vector<BenchRow>& rows) {
-    std::ostringstream out;
-    bool header = true;
-    const nlohmann::ordered_json columns = to_json(BenchRow{});  // items() must not outlive its object
-    for (const auto& key_value : columns.items()) {
-        out << (header ? "" : ",") << key_value.key();
-        header = false;
-    }
-    out << "\n";
-    for (const BenchRow& r : rows) {
-        bool first = true;
-        const nlohmann::ordered_json values = to_json(r);
-        for (const auto& key_value : values.items()) {
-            out << (first ? "" : ",") << csv_field(key_value.value());
-            first = false;
-        }
-        out << "\n";
-    }
-    write_text(path, out.str());
+    std::vector<nlohmann::ordered_json> objects;
+    for (const BenchRow& r : rows) objects.push_back(to_json(r));
+    write_csv_rows(path, to_json(BenchRow{}), objects);
 }
 
 }  // namespace raypack::app

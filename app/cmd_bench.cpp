@@ -1,5 +1,6 @@
 // raypack bench [SCENE...] [--accel LIST] [--packet LIST] [--rays KINDS | --rays-file FILE]
-//               [--threads LIST] [--repeat R] [--res W H] [--json FILE] [--csv FILE] [--quick]
+//               [--threads LIST] [--repeat R] [--res W H] [--offset POLICY] [--json FILE] [--csv FILE] [--quick]
+// raypack bench --tradeoff [--quick] [--repeat R] [--json FILE] [--csv FILE]: app/bench_tradeoff.h
 // Every structure, packet width and ray kind on the same scenes; each case
 // is checked against the brute-force oracle before it is timed (tinybvh's
 // ValidateTraceResult; Mitsuba's ray_intersect_naive), and a mismatch is an
@@ -13,7 +14,9 @@
 #include "app/accel_options.h"
 #include "app/bench_measure.h"
 #include "app/bench_report.h"
+#include "app/bench_tradeoff.h"
 #include "app/commands.h"
+#include "app/variant_options.h"
 #include "scene/load.h"
 
 namespace raypack::app {
@@ -64,13 +67,16 @@ struct BenchPlan {
     std::vector<int> threads{1};
     std::string rays_file;
     int repeat = 5, width = 512, height = 512;
+    OffsetPolicy offset = kDefaultOffset;
     bool quick = false;
 };
 
 void print_help() {
     std::printf(
         "usage: raypack bench [SCENE...] [--accel LIST] [--packet LIST] [--rays KINDS | --rays-file FILE]\n"
-        "                     [--threads LIST] [--repeat R] [--res W H] [--json FILE] [--csv FILE] [--quick]\n"
+        "                     [--threads LIST] [--repeat R] [--res W H] [--offset POLICY] [--json FILE] [--csv FILE]\n"
+        "                     [--quick]\n"
+        "       raypack bench --tradeoff [--quick] [--repeat R] [--json FILE] [--csv FILE]\n"
         "  SCENE          .nff, .obj or gen:NAME:SIZE (default gen:balls:4)\n"
         "  --accel LIST   comma-separated, from %s (default: all but brute,\n"
         "                 which is the oracle and takes minutes on large scenes)\n"
@@ -83,8 +89,12 @@ void print_help() {
         "  --res W H      image size of the generated ray sets (default 512 512)\n"
         "  --json FILE    one object per row; --csv FILE: the same columns (schema: README)\n"
         "  --quick        every structure (brute too), width and ray kind on gen:balls:3 at 256x256,\n"
-        "                 repeat 3: the CI smoke run; explicit options still apply\n",
-        accel_kinds_list().c_str());
+        "                 repeat 3: the CI smoke run; explicit options still apply\n"
+        "  --offset P     secondary-ray origins of the shadow and diffuse sets: %s (default %s)\n"
+        "  --tradeoff     speed against accuracy of each kernel and offset variant: throughput, leaks\n"
+        "                 at shared edges and vertices, t error in ULPs, self-intersections from\n"
+        "                 scale 1e-4 to 1e6, image error against a double reference (README)\n",
+        accel_kinds_list().c_str(), offset_policy_list().c_str(), offset_policy_name(kDefaultOffset));
 }
 
 BenchPlan plan_from(const ParsedArgs& p) {
@@ -123,6 +133,7 @@ BenchPlan plan_from(const ParsedArgs& p) {
         if (k != "camera" && k != "shadow" && k != "diffuse")
             throw UsageError("--rays: expected camera, shadow or diffuse, got '" + k + "'");
     if (!plan.rays_file.empty()) plan.ray_kinds = {"file"};
+    plan.offset = offset_policy_from(p);
     return plan;
 }
 
@@ -174,11 +185,19 @@ std::size_t count_cases(const BenchPlan& plan) {
 int run_bench(const Args& args) {
     const ParsedArgs p(args, {{"--accel", "", 1}, {"--packet", "", 1}, {"--rays", "", 1}, {"--rays-file", "", 1},
                               {"--threads", "", 1}, {"--repeat", "", 1}, {"--res", "", 2}, {"--json", "", 1},
-                              {"--csv", "", 1}, {"--quick", "", 0}},
+                              {"--csv", "", 1}, {"--quick", "", 0}, {"--tradeoff", "", 0}, offset_option_spec()},
                        1000);
     if (p.help()) {
         print_help();
         return 0;
+    }
+    if (p.has("--tradeoff")) {
+        for (const char* other : {"--accel", "--packet", "--rays", "--rays-file", "--threads", "--res", "--offset"})
+            if (p.has(other)) throw UsageError(std::string(other) + " does not apply to --tradeoff (it runs every variant)");
+        if (!p.positional().empty()) throw UsageError("--tradeoff takes no SCENE (it builds its own)");
+        return run_tradeoff(TradeoffPlan{.quick = p.has("--quick"),
+                                         .repeat = int(p.integer("--repeat", p.has("--quick") ? 3 : 9, 1, 1000)),
+                                         .json = p.text("--json"), .csv = p.text("--csv")});
     }
     const BenchPlan plan = plan_from(p);
     Progress progress(count_cases(plan));
@@ -193,7 +212,7 @@ int run_bench(const Args& args) {
         std::vector<OracleSample> samples;
         for (const std::string& kind : plan.ray_kinds) {
             sets.push_back(kind == "file" ? load_bench_rays(plan.rays_file)
-                                          : make_bench_rays(scene, kind, plan.width, plan.height));
+                                          : make_bench_rays(scene, kind, plan.width, plan.height, plan.offset));
             samples.push_back(oracle_sample(scene, sets.back(), kOracleRays));
         }
         for (const std::string& accel_kind : plan.accels) {

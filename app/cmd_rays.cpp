@@ -1,8 +1,9 @@
-// raypack rays SCENE --kind camera|shadow|diffuse [--res W H] [--seed S] -o FILE.rays
+// raypack rays SCENE --kind camera|shadow|diffuse [--res W H] [--seed S] [--offset POLICY] -o FILE.rays
 // Writes the ray sets the benchmarks and the Embree comparison trace.
 #include <cstdio>
 
 #include "app/commands.h"
+#include "app/variant_options.h"
 #include "render/camera_rays.h"
 #include "render/ray_sets.h"
 #include "scene/load.h"
@@ -11,18 +12,24 @@
 namespace raypack::app {
 
 int run_rays(const Args& args) {
-    const ParsedArgs p(args, {{"--kind", "", 1}, {"--res", "", 2}, {"--output", "-o", 1}, {"--seed", "", 1}}, 1);
+    const ParsedArgs p(args, {{"--kind", "", 1}, {"--res", "", 2}, {"--output", "-o", 1}, {"--seed", "", 1},
+                              offset_option_spec()},
+                       1);
     if (p.help() || p.positional().empty()) {
         std::printf(
-            "usage: raypack rays SCENE --kind camera|shadow|diffuse [--res W H] [--seed S] -o FILE.rays\n"
+            "usage: raypack rays SCENE --kind camera|shadow|diffuse [--res W H] [--seed S] [--offset POLICY]\n"
+            "                   -o FILE.rays\n"
             "  camera   one closest-hit ray through each pixel centre (kind 0)\n"
             "  shadow   any-hit rays from each camera hit to the first light (kind 1)\n"
-            "  diffuse  a cosine-weighted bounce from each camera hit (kind 0); --seed S (default 1)\n");
+            "  diffuse  a cosine-weighted bounce from each camera hit (kind 0); --seed S (default 1)\n"
+            "%s",
+            offset_option_help().c_str());
         if (!p.help()) throw UsageError("missing SCENE");
         return 0;
     }
     if (!p.has("--output")) throw UsageError("missing -o FILE.rays");
     const std::string kind = p.text("--kind", "camera");
+    const OffsetPolicy offset = offset_policy_from(p);
     const Scene scene = load_scene(p.positional()[0]);
     const int w = int(p.integer("--res", scene.camera.width, 1, 16384, 0));
     const int h = int(p.integer("--res", scene.camera.height, 1, 16384, 1));
@@ -31,10 +38,10 @@ int run_rays(const Args& args) {
     if (kind == "camera") {
         rays = camera_ray_set(scene, w, h);
     } else if (kind == "shadow") {
-        rays = shadow_ray_set(scene, w, h);
+        rays = shadow_ray_set(scene, w, h, offset);
         file_kind = RayKind::AnyHit;
     } else if (kind == "diffuse") {
-        rays = diffuse_ray_set(scene, w, h, std::uint64_t(p.integer("--seed", 1, 0, 1LL << 62)));
+        rays = diffuse_ray_set(scene, w, h, std::uint64_t(p.integer("--seed", 1, 0, 1LL << 62)), offset);
     } else {
         throw UsageError("--kind: expected camera, shadow or diffuse, got '" + kind + "'");
     }

@@ -1,4 +1,4 @@
-// raypack render SCENE [-o out.png] [--res W H] [--depth D] [--threads T] [--aov cost]
+// raypack render SCENE [-o out.png] [--res W H] [--depth D] [--threads T] [--aov cost] [--offset POLICY]
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -6,6 +6,7 @@
 #include "app/accel_options.h"
 #include "app/default_config.h"
 #include "app/commands.h"
+#include "app/variant_options.h"
 #include "render/cost_map.h"
 #include "render/whitted.h"
 #include "scene/load.h"
@@ -49,11 +50,12 @@ int render_cost(const Scene& scene, const Accel& accel, int width, int height, c
 int run_render(const Args& args) {
     auto spec = accel_option_specs();
     spec.insert(spec.end(), {{"--output", "-o", 1}, {"--res", "", 2}, {"--depth", "", 1}, {"--threads", "", 1},
-                             {"--aov", "", 1}});
+                             {"--aov", "", 1}, offset_option_spec()});
     const ParsedArgs p(args, spec, 1);
     if (p.help() || p.positional().empty()) {
         std::printf(
             "usage: raypack render SCENE [-o out.png] [--res W H] [--depth D] [--threads T] [--aov cost]\n"
+            "                     [--offset POLICY] [structure and kernel options]\n"
             "  -o FILE       output image; format from the extension (png, exr, ...)\n"
             "  --res W H     resolution (default: the scene's, 512x512 for SPD)\n"
             "  --depth D     maximum ray depth, eye ray = 1 (default 5, the SPD protocol)\n"
@@ -71,6 +73,7 @@ int run_render(const Args& args) {
     if (fastest) config.kind = fastest_config(RayWorkload::Camera).accel;
     WhittedOptions options;
     options.max_depth = int(p.integer("--depth", 5, 1, 64));
+    options.offset = offset_policy_from(p);
     const ThreadLimit limit(int(p.integer("--threads", 0, 1, 1024)));
     const std::string output = p.has("--output") ? p.text("--output") : default_output(scene_spec);
     const std::string aov = p.text("--aov");
@@ -103,8 +106,9 @@ int run_render(const Args& args) {
                 "%.2f refs/prim, %.1f KiB, SAH cost %.2f\n",
                 as.name.c_str(), as.builder.c_str(), as.build_ms, as.nodes, as.leaves, as.empty_leaves, as.depth,
                 as.refs_per_prim, double(as.bytes) / 1024.0, as.sah_cost);
-    std::printf("  render     %dx%d, depth %d, %d threads, primary packets of %d, Whitted: %.1f ms\n",
-                options.width, options.height, options.max_depth, limit.threads(), options.packet, stats.render_ms);
+    std::printf("  render     %dx%d, depth %d, %d threads, primary packets of %d, offset %s, Whitted: %.1f ms\n",
+                options.width, options.height, options.max_depth, limit.threads(), options.packet,
+                offset_policy_name(options.offset), stats.render_ms);
     std::printf("  rays       eye %llu (%llu hit), reflect %llu, refract %llu, shadow %llu\n",
                 (unsigned long long)stats.eye_rays, (unsigned long long)stats.eye_hits,
                 (unsigned long long)stats.reflect_rays, (unsigned long long)stats.refract_rays,

@@ -24,13 +24,12 @@ std::vector<Hitf> camera_hits(const Scene& scene, const std::vector<Rayf>& camer
     return hits;
 }
 
-/// The hit point moved off the surface, to the side the ray came from, by an
-/// amount relative to its magnitude so that the new ray does not hit the
-/// same surface again.
-Vec3f offset_origin(const Surface& s, const Vec3f& incoming) {
-    const Vec3f n = dot(s.geometric_normal, incoming) < 0 ? s.geometric_normal : -s.geometric_normal;
-    const float scale = std::max({std::fabs(s.point.x), std::fabs(s.point.y), std::fabs(s.point.z), 1e-3f});
-    return s.point + n * (1e-4f * scale);
+/// The hit point of `ray` moved off the surface by `offset`, to the side the
+/// ray came from, so that the new ray does not hit the same surface again.
+Vec3f offset_origin(const Scene& scene, const RayOffset& offset, const Rayf& ray, const Hitf& hit,
+                    const Surface& s) {
+    const Vec3f n = dot(s.geometric_normal, ray.dir) < 0 ? s.geometric_normal : -s.geometric_normal;
+    return offset.offset(offset.hit_point(scene, ray, hit, s.point), n);
 }
 
 /// SplitMix64 (Steele, Lea, Flood, OOPSLA 2014): a counter-based generator,
@@ -73,26 +72,28 @@ std::vector<Rayf> camera_ray_set(const Scene& scene, int width, int height) {
     return rays;
 }
 
-std::vector<Rayf> shadow_ray_set(const Scene& scene, int width, int height) {
+std::vector<Rayf> shadow_ray_set(const Scene& scene, int width, int height, OffsetPolicy policy) {
     if (scene.lights.empty()) return {};
     const std::vector<Rayf> camera = camera_ray_set(scene, width, height);
     const std::vector<Hitf> hits = camera_hits(scene, camera);
     const Vec3f light = scene.lights.front().position;
+    const RayOffset offset(policy, scene);
     std::vector<Rayf> rays;
     for (std::size_t i = 0; i < camera.size(); ++i) {
         if (!hits[i].found()) continue;
         Rayf r;
-        r.org = offset_origin(surface_at(scene, camera[i], hits[i]), camera[i].dir);
+        r.org = offset_origin(scene, offset, camera[i], hits[i], surface_at(scene, camera[i], hits[i]));
         r.dir = light - r.org;
-        r.tnear = 0;
+        r.tnear = offset.tnear();
         r.tfar = 1.0f - 1e-6f;
         rays.push_back(r);
     }
     return rays;
 }
 
-std::vector<Rayf> diffuse_ray_set(const Scene& scene, int width, int height, std::uint64_t seed) {
+std::vector<Rayf> diffuse_ray_set(const Scene& scene, int width, int height, std::uint64_t seed, OffsetPolicy policy) {
     const std::vector<Rayf> camera = camera_ray_set(scene, width, height);
+    const RayOffset offset(policy, scene);
     const std::vector<Hitf> hits = camera_hits(scene, camera);
     std::vector<Rayf> rays;
     for (std::size_t i = 0; i < camera.size(); ++i) {
@@ -103,8 +104,9 @@ std::vector<Rayf> diffuse_ray_set(const Scene& scene, int width, int height, std
         splitmix64(state);  // decorrelate neighbouring pixels before the first draw
         const float u1 = uniform01(state), u2 = uniform01(state);
         Rayf r;
-        r.org = offset_origin(s, camera[i].dir);
+        r.org = offset_origin(scene, offset, camera[i], hits[i], s);
         r.dir = to_world(n, cosine_hemisphere(u1, u2));
+        r.tnear = offset.tnear();
         rays.push_back(r);
     }
     return rays;

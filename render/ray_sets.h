@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "kernels/ray.h"
+#include "render/ray_offset.h"
 #include "scene/scene.h"
 
 namespace raypack {
@@ -12,9 +13,9 @@ namespace raypack {
 std::vector<Rayf> camera_ray_set(const Scene& scene, int width, int height);
 
 /// From each camera-ray hit (found with the reference BVH2) toward the first
-/// light, offset off the surface; tfar stops just short of the light. Empty
-/// when the scene has no light.
-std::vector<Rayf> shadow_ray_set(const Scene& scene, int width, int height);
+/// light, offset off the surface by `offset`; tfar stops just short of the
+/// light. Empty when the scene has no light.
+std::vector<Rayf> shadow_ray_set(const Scene& scene, int width, int height, OffsetPolicy offset = kDefaultOffset);
 
 /// From each camera-ray hit, one diffuse bounce: a cosine-weighted unit
 /// direction about the shading normal turned toward the incoming ray (Malley's
@@ -22,6 +23,7 @@ std::vector<Rayf> shadow_ray_set(const Scene& scene, int width, int height);
 /// Jakob, Humphreys, PBR 4th ed., 13.6.3). Pixel i draws from a generator
 /// seeded by (seed, i), so the set is the same every run and for any thread
 /// count. Origins are offset off the surface as for shadow rays; tfar = inf.
-std::vector<Rayf> diffuse_ray_set(const Scene& scene, int width, int height, std::uint64_t seed = 1);
+std::vector<Rayf> diffuse_ray_set(const Scene& scene, int width, int height, std::uint64_t seed = 1,
+                                  OffsetPolicy offset = kDefaultOffset);
 
 }  // namespace raypack

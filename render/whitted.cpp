@@ -15,17 +15,13 @@
 namespace raypack {
 namespace {
 
-float max_abs(const Vec3f& v) { return std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}); }
-
 class WhittedTracer {
 public:
     WhittedTracer(const Scene& scene, const Accel& accel, const WhittedOptions& options)
-        : scene_(scene), accel_(accel), options_(options) {
+        : scene_(scene), accel_(accel), options_(options), offset_(options.offset, scene) {
         // SPD Readme: each light and the ambient term get sqrt(L) / (2 L).
         const float n = float(std::max<std::size_t>(scene.lights.size(), 1));
         intensity_ = std::sqrt(n) / (2.0f * n);
-        const Box3f b = scene_bounds(scene);
-        scene_extent_ = b.empty() ? 1.0f : std::max(length(b.extent()), 1e-30f);
     }
 
     Vec3f trace(const Rayf& ray, int depth, RenderStats& stats) const {
@@ -46,12 +42,8 @@ private:
     const Scene& scene_;
     const Accel& accel_;
     const WhittedOptions& options_;
+    RayOffset offset_;
     float intensity_ = 1;
-    float scene_extent_ = 1;
-
-    float offset_at(const Vec3f& p) const {
-        return options_.offset_scale * std::max(max_abs(p), 1e-3f * scene_extent_);
-    }
 
     Vec3f shade(const Rayf& ray, const Hitf& hit, int depth, RenderStats& stats) const {
         const Surface s = surface_at(scene_, ray, hit);
@@ -62,8 +54,8 @@ private:
         const Vec3f ng = front ? s.geometric_normal : -s.geometric_normal;
         Vec3f ns = front ? s.shading_normal : -s.shading_normal;
         if (dot(ns, ng) < 0) ns = ng;  // interpolated normal bent past the surface
-        const float eps = offset_at(s.point);
-        const Vec3f above = s.point + ng * eps;
+        const Vec3f p = offset_.hit_point(scene_, ray, hit, s.point);
+        const Vec3f above = offset_.offset(p, ng);
 
         Vec3f color = m.color * (intensity_ * m.kd);  // ambient
         for (const PointLight& light : scene_.lights) {
@@ -76,7 +68,7 @@ private:
             Rayf shadow;
             shadow.org = above;
             shadow.dir = to_light;
-            shadow.tnear = 0;
+            shadow.tnear = offset_.tnear();
             shadow.tfar = 1.0f - 1e-6f;
             if (accel_.occluded1(shadow)) continue;
             const float atten =
@@ -109,7 +101,7 @@ private:
             if (k >= 0) {
                 ++stats.refract_rays;
                 const Vec3f dir = view * eta + ns * (eta * cos_i - std::sqrt(k));
-                color += trace(secondary(s.point - ng * eps, dir), depth + 1, stats) * m.transmittance;
+                color += trace(secondary(offset_.offset(p, -ng), dir), depth + 1, stats) * m.transmittance;
             } else {
                 color += reflected * m.transmittance;
             }
@@ -117,11 +109,11 @@ private:
         return color;
     }
 
-    static Rayf secondary(const Vec3f& org, const Vec3f& dir) {
+    Rayf secondary(const Vec3f& org, const Vec3f& dir) const {
         Rayf r;
         r.org = org;
         r.dir = dir;
-        r.tnear = 0;
+        r.tnear = offset_.tnear();
         return r;
     }
 };

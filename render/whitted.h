@@ -5,6 +5,7 @@
 
 #include "accel/accel.h"
 #include "render/image.h"
+#include "render/ray_offset.h"
 #include "scene/scene.h"
 
 namespace raypack {
@@ -15,9 +16,8 @@ struct WhittedOptions {
     int max_depth = 5;  ///< the eye ray has depth 1 (SPD protocol: 5)
     /// Distance attenuation 1 / (c2 r^2 + c1 r + c0) per light; NFF has none.
     float atten_c0 = 1, atten_c1 = 0, atten_c2 = 0;
-    /// Secondary-ray origins move this far along the normal, relative to the
-    /// larger of the hit point's magnitude and 1e-3 of the scene's extent.
-    float offset_scale = 1e-4f;
+    /// How secondary-ray origins move off the surface (render/ray_offset.h).
+    OffsetPolicy offset = kDefaultOffset;
     int tile_size = 16;
     /// Primary rays are traced as packets of this width (1, 4, 8, 16), each
     /// covering a compact block of pixels; secondary rays go one by one.

@@ -1,0 +1,71 @@
+#pragma once
+// Where a secondary ray starts: the hit point moved off the surface so that
+// the new ray does not find the surface it left (self-intersection, "surface
+// acne"). Three policies, selectable with --offset, compared by
+// `raypack bench --tradeoff` (README, "Speed against accuracy").
+#include <optional>
+#include <string>
+
+#include "kernels/ray.h"
+#include "render/surface.h"
+#include "scene/scene.h"
+
+namespace raypack {
+
+enum class OffsetPolicy {
+    Epsilon,  ///< a fixed 1e-4 along the normal, whatever the scene's size
+    Scaled,   ///< 1e-4 x max(|p|, 1e-3 x scene extent): relative to the magnitude
+    Robust,   ///< Waechter & Binder, Ray Tracing Gems ch. 6: 256 ULPs of each coordinate
+};
+
+/// What render, rays and bench use without --offset.
+inline constexpr OffsetPolicy kDefaultOffset = OffsetPolicy::Scaled;
+
+/// "epsilon" | "scaled" | "robust".
+const char* offset_policy_name(OffsetPolicy policy);
+std::optional<OffsetPolicy> parse_offset_policy(const std::string& name);
+/// The names joined by '|', for help and error messages.
+std::string offset_policy_list();
+
+/// The hit point as accurately as float allows: for triangles from the
+/// barycentrics (the vertices carry no error, org + t dir carries the error
+/// of t times |dir|), for spheres org + t dir projected back onto the sphere,
+/// for cones org + t dir (Waechter & Binder, RTG ch. 6.2).
+Vec3f accurate_hit_point(const Scene& scene, const Rayf& ray, const Hitf& hit);
+
+/// Moves secondary-ray origins off surfaces by one policy.
+class RayOffset {
+public:
+    /// `scene_extent`: the diagonal of the scene's bounds (Scaled only).
+    RayOffset(OffsetPolicy policy, float scene_extent) : policy_(policy), scene_extent_(scene_extent) {}
+    /// Extent taken from `scene`'s bounds.
+    RayOffset(OffsetPolicy policy, const Scene& scene);
+
+    OffsetPolicy policy() const { return policy_; }
+
+    /// The point secondary rays leave from before the offset: robust takes
+    /// accurate_hit_point, as the chapter requires (its 256 ULPs cover the
+    /// error of that point, not of org + t dir); the others `surface_point`.
+    Vec3f hit_point(const Scene& scene, const Rayf& ray, const Hitf& hit, const Vec3f& surface_point) const {
+        return policy_ == OffsetPolicy::Robust ? accurate_hit_point(scene, ray, hit) : surface_point;
+    }
+
+    /// `p` moved to the side unit normal `n` points to.
+    Vec3f offset(const Vec3f& p, const Vec3f& n) const;
+
+    /// The tnear secondary rays from an offset origin start at: 0 for every
+    /// policy, since the origin is already off the surface (robust: tnear = 0
+    /// as the chapter prescribes; a positive tnear would skip nearby geometry).
+    float tnear() const { return 0.0f; }
+
+private:
+    OffsetPolicy policy_;
+    float scene_extent_;
+};
+
+/// Waechter & Binder's offset on its own: every coordinate of `p` moved
+/// 256 ULPs toward the side of `n`, or 1/65536 x n where |p| < 1/32 (ULPs
+/// are too small near zero).
+Vec3f offset_ray_origin_robust(const Vec3f& p, const Vec3f& n);
+
+}  // namespace raypack
