@@ -155,9 +155,11 @@ void run_kernel_family(const KernelFamily& family, const TradeoffPlan& plan, con
     for (std::size_t v = 0; v < family.variants.size(); ++v) {
         const auto& [variant, kernels] = family.variants[v];
         stages.note(name + " " + variant);
-        const AccelConfig config{.kind = "bvh2", .kernels = kernels};
-        TradeoffRow row{.family = name, .variant = variant, .throughput_scene = family.timing_scene,
-                        .throughput_rays = "camera"};
+        AccelConfig config;
+        config.kind = "bvh2", config.kernels = kernels;
+        TradeoffRow row;
+        row.family = name, row.variant = variant, row.throughput_scene = family.timing_scene;
+        row.throughput_rays = "camera";
         set_throughput(row, camera.rays.size(), ms[v]);
         row.leaks = family.count_leaks(family.leak_scene, *build_accel(family.leak_scene.scene, config),
                                        sizes.leak_rays, 1);
@@ -234,8 +236,9 @@ void run_offset_family(const TradeoffPlan& plan, const TradeoffSizes& sizes, con
     for (std::size_t v = 0; v < std::size(policies); ++v) {
         const OffsetPolicy policy = policies[v];
         stages.note(std::string("offset ") + offset_policy_name(policy));
-        TradeoffRow row{.family = "offset", .variant = offset_policy_name(policy),
-                        .throughput_scene = kSphereTimingScene, .throughput_rays = "shadow"};
+        TradeoffRow row;
+        row.family = "offset", row.variant = offset_policy_name(policy);
+        row.throughput_scene = kSphereTimingScene, row.throughput_rays = "shadow";
         set_throughput(row, camera.size(), ms[v]);
         for (std::size_t i = 0; i < placed.size(); ++i)
             row.self.push_back(count_self_intersections(placed[i], *placed_accels[i], policy, sizes.self_res,

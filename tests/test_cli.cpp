@@ -113,8 +113,8 @@ TEST(Cli, TraceDefaultsToTheFastestConfigurationForTheRays) {
         const char* accel;
         int packet;
     };
-    for (const Case& c : {Case{"camera", "camera", "bvh8", 16}, Case{"shadow", "shadow", "bvh4", 16},
-                          Case{"diffuse", "diffuse", "bvh8", 1}}) {
+    for (const Case& c : {Case{"camera", "camera", "bvh4", 16}, Case{"shadow", "shadow", "bvh8", 16},
+                          Case{"diffuse", "diffuse", "bvh4", 16}}) {
         const std::string rays = (dir / (std::string("default_") + c.kind + ".rays")).string();
         ASSERT_EQ(run("rays " + scene + " --kind " + c.kind + " --res 32 32 -o " + rays).status, 0);
         const Result r = run("trace " + scene + " --rays " + rays + " --repeat 1 --json");
