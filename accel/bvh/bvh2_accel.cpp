@@ -7,6 +7,7 @@
 #include "accel/bvh/build_from_scene.h"
 #include "accel/bvh/bvh2_finalize.h"
 #include "accel/bvh/bvh2_packet.h"
+#include "accel/bvh/bvh2_traversal.h"
 #include "kernels/simd.h"
 
 namespace raypack {
@@ -27,51 +28,10 @@ Bvh2Accel::Bvh2Accel(const Scene& scene, const AccelConfig& config) : scene_(&sc
     stats_.refs_per_prim = stats_.primitives ? double(bvh_.prim_index.size()) / double(stats_.primitives) : 1.0;
 }
 
-// Depth-first traversal, nearer child first, with an explicit stack.
 template <bool AnyHit>
 bool Bvh2Accel::trace(Rayf& ray, Hitf& hit) const {
     if (bvh_.nodes.empty()) return false;
-    const PrimitiveIntersector<float> isect{scene_, kernels_};
-    const Vec3f inv_dir = reciprocal(ray.dir);
-    const Bvh2Node* nodes = bvh_.nodes.data();
-    float entry;
-    if (!intersect_aabb(ray.org, inv_dir, nodes[0].box, ray.tnear, ray.tfar, entry)) return false;
-    std::uint32_t stack[kBvhMaxDepth + 1];
-    int sp = 0;
-    std::uint32_t current = 0;
-    bool found = false;
-    for (;;) {
-        const Bvh2Node& node = nodes[current];
-        if (node.is_leaf()) {
-            for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
-                if (isect.intersect(bvh_.prim_index[k], ray, hit)) {
-                    found = true;
-                    if constexpr (AnyHit) return true;
-                }
-            }
-        } else {
-            const std::uint32_t left = current + 1, right = node.first;
-            float t_left, t_right;
-            const bool hit_left = intersect_aabb(ray.org, inv_dir, nodes[left].box, ray.tnear, ray.tfar, t_left);
-            const bool hit_right = intersect_aabb(ray.org, inv_dir, nodes[right].box, ray.tnear, ray.tfar, t_right);
-            if (hit_left && hit_right) {
-                const bool left_first = t_left <= t_right;
-                stack[sp++] = left_first ? right : left;
-                current = left_first ? left : right;
-                continue;
-            }
-            if (hit_left || hit_right) {
-                current = hit_left ? left : right;
-                continue;
-            }
-        }
-        // Pop, skipping nodes the ray can no longer reach before its closest hit.
-        for (;;) {
-            if (sp == 0) return found;
-            current = stack[--sp];
-            if (intersect_aabb(ray.org, inv_dir, nodes[current].box, ray.tnear, ray.tfar, entry)) break;
-        }
-    }
+    return trace_bvh2_subtree<AnyHit>(bvh_, PrimitiveIntersector<float>{scene_, kernels_}, 0, ray, hit);
 }
 
 void Bvh2Accel::intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const {
