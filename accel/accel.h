@@ -6,6 +6,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <utility>
 
 #include "accel/primitive_intersector.h"
 #include "kernels/ray.h"
@@ -49,6 +50,15 @@ struct AccelConfig {
     float spatial_alpha = 1e-5f;     ///< sbvh: overlap (relative to the root) that makes spatial splits worth trying
     float reference_budget = 1.3f;   ///< sbvh: at most this many references per primitive
 };
+
+/// The structure `kind` with the given kernels and every other setting at its
+/// default (designated initializers would leave -Wextra warning about the rest).
+inline AccelConfig accel_config(std::string kind, KernelChoice kernels = {}) {
+    AccelConfig config;
+    config.kind = std::move(kind);
+    config.kernels = kernels;
+    return config;
+}
 
 class Accel {
 public:

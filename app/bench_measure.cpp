@@ -101,7 +101,7 @@ OracleSample oracle_sample(const Scene& scene, const BenchRays& set, std::size_t
     s.index = sample_positions(set.rays.size(), max_rays, kSampleBlock);
     s.rays = gather(set.rays, s.index);
     s.expected.resize(s.rays.size());
-    const auto oracle = build_accel(scene, AccelConfig{.kind = "brute"});
+    const auto oracle = build_accel(scene, accel_config("brute"));
     trace_all(*oracle, 1, set.any_hit, s.rays, s.expected, 16);
     return s;
 }

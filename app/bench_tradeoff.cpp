@@ -147,7 +147,7 @@ void run_kernel_family(const KernelFamily& family, const TradeoffPlan& plan, con
     std::vector<std::unique_ptr<Accel>> accels;
     std::vector<std::function<double()>> passes;
     for (const auto& [variant, kernels] : family.variants) {
-        accels.push_back(build_accel(timing_scene, AccelConfig{.kind = "bvh2", .kernels = kernels}));
+        accels.push_back(build_accel(timing_scene, accel_config("bvh2", kernels)));
         passes.push_back([&camera, &accel = *accels.back()] { return time_one_pass(accel, camera); });
     }
     stages.note(name + ": timing the variants in turns");

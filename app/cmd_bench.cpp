@@ -22,13 +22,6 @@
 namespace raypack::app {
 namespace {
 
-/// The structure `kind` with every other setting at its default.
-AccelConfig config_of(const std::string& kind) {
-    AccelConfig config;
-    config.kind = kind;
-    return config;
-}
-
 constexpr std::size_t kOracleRays = 2048;   // rays checked against brute force per case
 constexpr std::size_t kCountedRays = 65536; // rays walked by the counting traversal per case
 constexpr int kPacketWidths[] = {1, 4, 8, 16};
@@ -176,7 +169,7 @@ std::size_t count_cases(const BenchPlan& plan) {
     std::size_t per_scene = 0;
     std::vector<std::string> ignored;
     for (const std::string& a : plan.accels)
-        per_scene += packet_widths(plan, *build_accel(probe, config_of(a)), ignored).size();
+        per_scene += packet_widths(plan, *build_accel(probe, accel_config(a)), ignored).size();
     return per_scene * plan.scenes.size() * plan.ray_kinds.size() * plan.threads.size();
 }
 
@@ -216,7 +209,7 @@ int run_bench(const Args& args) {
             samples.push_back(oracle_sample(scene, sets.back(), kOracleRays));
         }
         for (const std::string& accel_kind : plan.accels) {
-            const auto accel = build_accel(scene, config_of(accel_kind));
+            const auto accel = build_accel(scene, accel_config(accel_kind));
             const AccelStats& stats = accel->stats();
             const std::vector<int> widths = packet_widths(plan, *accel, skipped);
             for (std::size_t s = 0; s < sets.size(); ++s) {

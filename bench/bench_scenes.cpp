@@ -63,7 +63,7 @@ void trace(const Accel& accel, int packet, bool any_hit, const std::vector<Rayf>
 /// Empty if the sample agrees with the oracle, else what differs.
 std::string disagreement(const Scene& scene, bool any_hit, const std::vector<Rayf>& rays,
                          const std::vector<Hitf>& hits) {
-    const auto oracle = build_accel(scene, AccelConfig{.kind = "brute"});
+    const auto oracle = build_accel(scene, accel_config("brute"));
     for (std::size_t i = 0; i < rays.size(); i += kSampleStride) {
         const Hitf want = oracle->intersect1(rays[i]);
         const bool found = any_hit ? oracle->occluded1(rays[i]) : want.found();
@@ -80,7 +80,7 @@ void scene_case(benchmark::State& state, const std::string& file, const std::str
     const std::vector<Rayf>& rays = data.rays.at(rays_kind);
     if (rays.empty()) return state.SkipWithError("no rays of this kind in this scene");
     const bool any_hit = rays_kind == "shadow";
-    const auto accel = build_accel(data.scene, AccelConfig{.kind = kind});
+    const auto accel = build_accel(data.scene, accel_config(kind));
     std::vector<Hitf> hits(rays.size());
     trace(*accel, packet, any_hit, rays, hits);
     if (const std::string why = disagreement(data.scene, any_hit, rays, hits); !why.empty())
@@ -102,7 +102,7 @@ void register_scene_cases() {
     const Scene probe = load_scene("gen:balls:1");
     for (const char* kind : accel_kinds()) {
         if (std::string(kind) == "brute") continue;  // the oracle: minutes per case on the large scenes
-        const auto accel = build_accel(probe, AccelConfig{.kind = kind});
+        const auto accel = build_accel(probe, accel_config(kind));
         for (int packet : {1, 4, 8, 16}) {
             if (!accel->supports_packet(packet)) continue;
             for (const char* file : kScenes)

@@ -177,9 +177,9 @@ LeakCounts count_mesh_leaks(const ObjectScene& meshes, const Accel& accel, std::
                 // From beyond the target on the line from `inner`: the ray
                 // meets the surface at the target and goes on toward `inner`,
                 // which it reaches at t = 1 + 1/k.
-                const float k = float(uniform(g, 1, 3));
-                ray.org = target + (target - inner) * k;
-                limits.push_back(1.0f + 0.5f / k);
+                const float beyond = float(uniform(g, 1, 3));
+                ray.org = target + (target - inner) * beyond;
+                limits.push_back(1.0f + 0.5f / beyond);
             }
             ray.dir = target - ray.org;
             rays.push_back(ray);

@@ -1,9 +1,8 @@
 // raypack bench's check before timing must catch a structure that answers
-// wrongly, and name the case and the ray. The measuring code lives in the
-// CLI (app/), which is not part of raypack_core, so it is compiled in here.
+// wrongly, and name the case and the ray.
 #include <gtest/gtest.h>
 
-#include "app/bench_measure.cpp"  // NOLINT: the unit under test, see above
+#include "app/bench_measure.h"
 #include "scene/load.h"
 
 namespace raypack::app {
@@ -36,7 +35,7 @@ TEST(BenchValidation, AgreeingStructurePasses) {
     const OracleSample sample = oracle_sample(scene, set, 512);
     ASSERT_EQ(sample.rays.size(), 512u);
     for (const char* kind : {"bvh2", "grid", "kdtree"})
-        EXPECT_NO_THROW(validate_against_oracle(*build_accel(scene, AccelConfig{.kind = kind}), 1, set, sample, kind));
+        EXPECT_NO_THROW(validate_against_oracle(*build_accel(scene, accel_config(kind)), 1, set, sample, kind));
 }
 
 TEST(BenchValidation, DroppedHitIsAnErrorNamingCaseAndRay) {

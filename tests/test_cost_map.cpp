@@ -21,7 +21,7 @@ bool near(const Vec3f& a, const Vec3f& b) {
 TEST(CostMap, GeometryCostsMoreThanBackground) {
     const Scene scene = load_scene("gen:tetra:3");
     for (const char* kind : {"bvh2", "bvh8", "grid", "kdtree", "octree"}) {
-        const auto accel = build_accel(scene, AccelConfig{.kind = kind});
+        const auto accel = build_accel(scene, accel_config(kind));
         const CostMap map = primary_ray_cost(scene, *accel, 96, 96);
         double on = 0, off = 0;
         std::size_t n_on = 0, n_off = 0;

@@ -23,7 +23,7 @@ namespace fs = std::filesystem;
 
 LeakCounts mesh_leaks(TriangleMethod method, std::uint64_t rays) {
     static const ObjectScene meshes = leak_test_meshes(0, 3);
-    const auto accel = build_accel(meshes.scene, AccelConfig{.kernels = KernelChoice{.triangle = method}});
+    const auto accel = build_accel(meshes.scene, accel_config("bvh2", KernelChoice{.sphere = SphereMethod::Geometric, .triangle = method}));
     return count_mesh_leaks(meshes, *accel, rays);
 }
 
@@ -55,15 +55,15 @@ TEST(Tradeoff, LeakMeasureIsTheSameForEveryStructure) {
     const ObjectScene meshes = leak_test_meshes(0, 2);
     const KernelChoice moeller{.triangle = TriangleMethod::Moeller};
     const LeakCounts brute =
-        count_mesh_leaks(meshes, *build_accel(meshes.scene, AccelConfig{.kind = "brute", .kernels = moeller}), 20000);
-    const LeakCounts bvh = count_mesh_leaks(meshes, *build_accel(meshes.scene, AccelConfig{.kernels = moeller}), 20000);
+        count_mesh_leaks(meshes, *build_accel(meshes.scene, accel_config("brute", moeller)), 20000);
+    const LeakCounts bvh = count_mesh_leaks(meshes, *build_accel(meshes.scene, accel_config("bvh2", moeller)), 20000);
     EXPECT_EQ(brute.leaks(), bvh.leaks());
     EXPECT_EQ(brute.rays(), bvh.rays());
 }
 
 TEST(Tradeoff, PreciseSphereTestHasNoLeakFromInside) {
     const ObjectScene spheres = leak_test_spheres();
-    const auto accel = build_accel(spheres.scene, AccelConfig{.kernels = KernelChoice{.sphere = SphereMethod::Precise}});
+    const auto accel = build_accel(spheres.scene, accel_config("bvh2", KernelChoice{.sphere = SphereMethod::Precise, .triangle = TriangleMethod::Moeller}));
     const LeakCounts c = count_sphere_leaks(spheres, *accel, 200'000);
     EXPECT_EQ(c.inside_rays, 200'000u);
     EXPECT_EQ(c.inside_leaks, 0u);
@@ -142,9 +142,11 @@ TEST(Tradeoff, QuickBenchWritesTheSchemaAndMeetsTheTargets) {
         if (row["variant"] == "robust") {
             saw_robust = true;
             EXPECT_GT(row["self_rays"].get<std::uint64_t>(), 0u);
-            for (const auto& [key, value] : row.items())
-                if (key.rfind("self_shadow_hits_", 0) == 0 || key.rfind("self_reflect_hits_", 0) == 0)
+            for (const auto& [key, value] : row.items()) {
+                if (key.rfind("self_shadow_hits_", 0) == 0 || key.rfind("self_reflect_hits_", 0) == 0) {
                     EXPECT_EQ(value.get<std::uint64_t>(), 0u) << key;
+                }
+            }
         }
         EXPECT_GT(row["mrays_per_s_median"].get<double>(), 0);
     }

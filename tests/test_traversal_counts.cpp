@@ -31,7 +31,7 @@ std::vector<Rayf> test_rays(const Scene& scene) {
 
 void expect_same_answers(const std::string& kind, const std::string& scene_spec) {
     const Scene scene = load_scene(scene_spec);
-    const auto accel = build_accel(scene, AccelConfig{.kind = kind});
+    const auto accel = build_accel(scene, accel_config(kind));
     const std::vector<Rayf> rays = test_rays(scene);
     std::vector<Hitf> expected(rays.size()), counted(rays.size());
     accel->intersect(rays, expected);
@@ -39,7 +39,9 @@ void expect_same_answers(const std::string& kind, const std::string& scene_spec)
     ASSERT_TRUE(accel->count_traversal(rays, false, counted, closest));
     for (std::size_t i = 0; i < rays.size(); ++i) {
         ASSERT_EQ(expected[i].prim, counted[i].prim) << kind << " ray " << i << ": " << describe(rays[i]);
-        if (expected[i].found()) ASSERT_EQ(expected[i].t, counted[i].t) << kind << " ray " << i;
+        if (expected[i].found()) {
+            ASSERT_EQ(expected[i].t, counted[i].t) << kind << " ray " << i;
+        }
     }
     std::vector<std::uint8_t> occluded(rays.size());
     accel->occluded(rays, occluded);
@@ -75,7 +77,7 @@ INSTANTIATE_TEST_SUITE_P(Accels, TraversalCountsTest, ::testing::ValuesIn(counta
 #ifdef RAYPACK_HAVE_EMBREE
 TEST(TraversalCounts, EmbreeSaysItCannotCount) {
     const Scene scene = load_scene("gen:balls:1");
-    const auto accel = build_accel(scene, AccelConfig{.kind = "embree"});
+    const auto accel = build_accel(scene, accel_config("embree"));
     std::vector<Rayf> rays = camera_ray_set(scene, 4, 4);
     std::vector<Hitf> hits(rays.size());
     TraversalCounts counts;
