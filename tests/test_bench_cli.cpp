@@ -18,8 +18,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
+/// One directory per test: ctest runs the tests of this file in parallel,
+/// and a shared bench.log let one test read another's output.
 fs::path temp_dir() {
-    const fs::path d = fs::temp_directory_path() / "raypack_test_bench_cli";
+    const fs::path d = fs::temp_directory_path() / "raypack_test_bench_cli" /
+                       ::testing::UnitTest::GetInstance()->current_test_info()->name();
     fs::create_directories(d);
     return d;
 }

@@ -35,8 +35,10 @@ Result run(const std::string& args) {
     return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
 }
 
+/// One directory per test: ctest runs these tests in parallel.
 fs::path temp_dir() {
-    const fs::path d = fs::temp_directory_path() / "raypack_test_cli";
+    const fs::path d = fs::temp_directory_path() / "raypack_test_cli" /
+                       ::testing::UnitTest::GetInstance()->current_test_info()->name();
     fs::create_directories(d);
     return d;
 }
