@@ -4,18 +4,33 @@
 // packet whose rays have drifted apart (bvh2_packet.cpp).
 #include <cstdint>
 
+#include "accel/accel.h"
 #include "accel/bvh/bvh2.h"
 #include "accel/primitive_intersector.h"
 #include "kernels/aabb.h"
 
 namespace raypack {
 
+/// What the timed traversal counts: nothing (the calls compile away).
+struct NoTraversalCounts {
+    void node() {}
+    void prim() {}
+};
+
+/// What count_traversal counts: nodes entered and primitives tested.
+struct CountTraversal {
+    TraversalCounts& counts;
+    void node() { ++counts.nodes; }
+    void prim() { ++counts.prims; }
+};
+
 /// Closest hit (or, AnyHit, any hit) of `ray` among the primitives below
 /// `root`; shrinks ray.tfar to each hit. Returns whether it found one.
-/// Depth-first, nearer child first, with an explicit stack.
-template <bool AnyHit>
+/// Depth-first, nearer child first, with an explicit stack. `count` sees
+/// each node entered and each primitive tested.
+template <bool AnyHit, class Count = NoTraversalCounts>
 inline bool trace_bvh2_subtree(const Bvh2& bvh, const PrimitiveIntersector<float>& isect, std::uint32_t root,
-                               Rayf& ray, Hitf& hit) {
+                               Rayf& ray, Hitf& hit, Count count = {}) {
     const Vec3f inv_dir = reciprocal(ray.dir);
     const Bvh2Node* nodes = bvh.nodes.data();
     float entry;
@@ -25,9 +40,11 @@ inline bool trace_bvh2_subtree(const Bvh2& bvh, const PrimitiveIntersector<float
     std::uint32_t current = root;
     bool found = false;
     for (;;) {
+        count.node();
         const Bvh2Node& node = nodes[current];
         if (node.is_leaf()) {
             for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
+                count.prim();
                 if (isect.intersect(bvh.prim_index[k], ray, hit)) {
                     found = true;
                     if constexpr (AnyHit) return true;
