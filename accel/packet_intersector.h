@@ -27,6 +27,7 @@ struct PacketPrimitiveIntersector {
     /// records the hit in those lanes of `hit` and shrinks their tfar.
     RAYPACK_INLINE mask_of<F> intersect(mask_of<F> valid, RayLanes<F>& ray, HitLanes<F>& hit,
                                         std::uint32_t prim) const {
+        if (kernels.precision == Precision::Double) return intersect_lanes_in_double(valid, ray, hit, prim);
         const PrimRef ref = scene->prims[prim];
         const std::uint32_t i = ref.index;
         F t, u(0.0f), v(0.0f);
@@ -79,6 +80,33 @@ struct PacketPrimitiveIntersector {
         ray.tfar = select(m, t, ray.tfar);
         for (std::uint32_t bits = mask_bits(m); bits; bits &= bits - 1) hit.prim[std::countr_zero(bits)] = prim;
         return m;
+    }
+
+private:
+    /// --precision double: the active lanes one by one through the scalar
+    /// double test (there is no double packet kernel; double is the
+    /// reference, not the fast path).
+    __attribute__((noinline)) mask_of<F> intersect_lanes_in_double(mask_of<F> valid, RayLanes<F>& ray,
+                                                                   HitLanes<F>& hit, std::uint32_t prim) const {
+        constexpr int K = lanes_of<F>;
+        alignas(64) float ox[K], oy[K], oz[K], dx[K], dy[K], dz[K], tn[K], tf[K], ht[K], hu[K], hv[K], hitf[K];
+        store_lanes(ox, ray.org.x), store_lanes(oy, ray.org.y), store_lanes(oz, ray.org.z);
+        store_lanes(dx, ray.dir.x), store_lanes(dy, ray.dir.y), store_lanes(dz, ray.dir.z);
+        store_lanes(tn, ray.tnear), store_lanes(tf, ray.tfar);
+        store_lanes(ht, hit.t), store_lanes(hu, hit.u), store_lanes(hv, hit.v);
+        const PrimitiveIntersector<float> single{scene, kernels};
+        for (int l = 0; l < K; ++l) {
+            hitf[l] = 0.0f;
+            if (!((mask_bits(valid) >> l) & 1u)) continue;
+            Rayf r;
+            r.org = {ox[l], oy[l], oz[l]}, r.dir = {dx[l], dy[l], dz[l]}, r.tnear = tn[l], r.tfar = tf[l];
+            Hitf h;
+            if (!single.intersect(prim, r, h)) continue;
+            ht[l] = h.t, hu[l] = h.u, hv[l] = h.v, tf[l] = r.tfar, hit.prim[l] = prim, hitf[l] = 1.0f;
+        }
+        hit.t = load_lanes<F>(ht), hit.u = load_lanes<F>(hu), hit.v = load_lanes<F>(hv);
+        ray.tfar = load_lanes<F>(tf);
+        return load_lanes<F>(hitf) != F(0.0f);
     }
 };
 

@@ -8,7 +8,60 @@
 namespace raypack::app {
 
 std::vector<OptionSpec> accel_option_specs() {
-    return {{"--accel", "", 1}, {"--sphere", "", 1}, {"--triangle", "", 1}, {"--packet", "", 1}, {"--builder", "", 1}};
+    std::vector<OptionSpec> specs = {{"--accel", "", 1}, {"--packet", "", 1}, {"--builder", "", 1}};
+    for (OptionSpec& k : kernel_option_specs()) specs.push_back(std::move(k));
+    return specs;
+}
+
+namespace {
+
+template <class E>
+struct Named {
+    const char* name;
+    E value;
+};
+
+constexpr Named<SphereMethod> kSphereNames[] = {
+    {"geometric", SphereMethod::Geometric}, {"algebraic", SphereMethod::Algebraic}, {"precise", SphereMethod::Precise}};
+constexpr Named<TriangleMethod> kTriangleNames[] = {
+    {"moeller", TriangleMethod::Moeller}, {"watertight", TriangleMethod::Watertight}, {"plane", TriangleMethod::Plane}};
+constexpr Named<SlabMethod> kSlabNames[] = {{"robust", SlabMethod::Robust}, {"plain", SlabMethod::Plain}};
+constexpr Named<Precision> kPrecisionNames[] = {{"float", Precision::Float}, {"double", Precision::Double}};
+constexpr Named<RcpMethod> kRcpNames[] = {{"exact", RcpMethod::Exact}, {"approx", RcpMethod::Approx}};
+
+/// The value `option` names, or its default (the first entry) without it.
+template <class E, std::size_t N>
+E parse_named(const ParsedArgs& args, const char* option, const Named<E> (&names)[N]) {
+    if (!args.has(option)) return names[0].value;
+    const std::string text = args.text(option);
+    std::string expected;
+    for (const Named<E>& n : names) {
+        if (text == n.name) return n.value;
+        if (!expected.empty()) expected += '|';
+        expected += n.name;
+    }
+    throw UsageError(std::string(option) + ": expected " + expected + ", got '" + text + "'");
+}
+
+template <class E, std::size_t N>
+const char* name_of(E value, const Named<E> (&names)[N]) {
+    for (const Named<E>& n : names)
+        if (n.value == value) return n.name;
+    return "?";
+}
+
+}  // namespace
+
+const char* sphere_method_name(SphereMethod m) { return name_of(m, kSphereNames); }
+const char* triangle_method_name(TriangleMethod m) { return name_of(m, kTriangleNames); }
+const char* slab_method_name(SlabMethod m) { return name_of(m, kSlabNames); }
+const char* precision_name(Precision p) { return name_of(p, kPrecisionNames); }
+const char* rcp_method_name(RcpMethod m) { return name_of(m, kRcpNames); }
+
+std::string kernel_choice_summary(const KernelChoice& k) {
+    return std::string(triangle_method_name(k.triangle)) + " triangles, " + sphere_method_name(k.sphere) +
+           " spheres, " + slab_method_name(k.slabs) + " slabs, " + rcp_method_name(k.rcp) + " rcp, " +
+           precision_name(k.precision);
 }
 
 std::string accel_options_help() {
@@ -17,9 +70,30 @@ std::string accel_options_help() {
            "  --accel " + accel_kinds_list() + "  acceleration structure (default bvh2)\n"
            "  --builder " + bvh_builder_list() + "  BVH builder for bvh2|bvh4|bvh8 (default binned):\n"
            "                binned SAH, full-sweep SAH, Morton/LBVH, spatial splits (SBVH)\n"
-           "  --sphere geometric|algebraic|precise     ray-sphere test (default geometric)\n"
-           "  --triangle moeller|watertight|plane     ray-triangle test (default moeller)\n"
+           + kernel_options_help() +
            "  --packet 1|4|8|16             rays per packet (default 1; 16 needs AVX-512)\n";
+}
+
+std::vector<OptionSpec> kernel_option_specs() {
+    return {{"--sphere", "", 1}, {"--triangle", "", 1}, {"--slabs", "", 1}, {"--precision", "", 1}, {"--rcp", "", 1}};
+}
+
+KernelChoice kernel_choice_from(const ParsedArgs& args) {
+    KernelChoice k;
+    k.sphere = parse_named(args, "--sphere", kSphereNames);
+    k.triangle = parse_named(args, "--triangle", kTriangleNames);
+    k.slabs = parse_named(args, "--slabs", kSlabNames);
+    k.precision = parse_named(args, "--precision", kPrecisionNames);
+    k.rcp = parse_named(args, "--rcp", kRcpNames);
+    return k;
+}
+
+std::string kernel_options_help() {
+    return "  --sphere geometric|algebraic|precise     ray-sphere test (default geometric)\n"
+           "  --triangle moeller|watertight|plane     ray-triangle test (default moeller)\n"
+           "  --slabs robust|plain          box test of the traversal (default robust: Ize 2013)\n"
+           "  --rcp exact|approx            reciprocal directions: division, or rcp + one Newton step\n"
+           "  --precision float|double      arithmetic of the primitive tests (default float)\n";
 }
 
 AccelConfig accel_config_from(const ParsedArgs& args) {
@@ -36,16 +110,11 @@ AccelConfig accel_config_from(const ParsedArgs& args) {
         if (config.kind != "bvh2" && config.kind != "bvh4" && config.kind != "bvh8")
             throw UsageError("--builder applies to bvh2, bvh4 and bvh8 only, not to --accel " + config.kind);
     }
-    const std::string sphere = args.text("--sphere", "geometric");
-    if (sphere == "geometric") config.kernels.sphere = SphereMethod::Geometric;
-    else if (sphere == "algebraic") config.kernels.sphere = SphereMethod::Algebraic;
-    else if (sphere == "precise") config.kernels.sphere = SphereMethod::Precise;
-    else throw UsageError("--sphere: expected geometric, algebraic or precise, got '" + sphere + "'");
-    const std::string tri = args.text("--triangle", "moeller");
-    if (tri == "moeller") config.kernels.triangle = TriangleMethod::Moeller;
-    else if (tri == "plane") config.kernels.triangle = TriangleMethod::Plane;
-    else if (tri == "watertight") config.kernels.triangle = TriangleMethod::Watertight;
-    else throw UsageError("--triangle: expected moeller, watertight or plane, got '" + tri + "'");
+    config.kernels = kernel_choice_from(args);
+    if (config.kind == "embree")
+        for (const OptionSpec& option : kernel_option_specs())
+            if (args.has(option.name))
+                throw UsageError(option.name + " does not apply to --accel embree (Embree runs its own tests)");
     return config;
 }
 

@@ -1,5 +1,6 @@
 #pragma once
 // Options shared by render and trace that choose the structure and kernels.
+#include <string>
 #include <vector>
 
 #include "accel/accel.h"
@@ -7,8 +8,20 @@
 
 namespace raypack::app {
 
-/// --accel, --builder, --sphere, --triangle, --packet
+/// --accel, --builder, --sphere, --triangle, --slabs, --precision, --rcp, --packet
 std::vector<OptionSpec> accel_option_specs();
+/// --sphere, --triangle, --slabs, --precision, --rcp: the kernel variants.
+std::vector<OptionSpec> kernel_option_specs();
+KernelChoice kernel_choice_from(const ParsedArgs& args);
+std::string kernel_options_help();
+/// The option values that name each kernel variant.
+const char* sphere_method_name(SphereMethod m);
+const char* triangle_method_name(TriangleMethod m);
+const char* slab_method_name(SlabMethod m);
+const char* precision_name(Precision p);
+const char* rcp_method_name(RcpMethod m);
+/// e.g. "moeller triangles, geometric spheres, robust slabs, exact rcp, float".
+std::string kernel_choice_summary(const KernelChoice& k);
 AccelConfig accel_config_from(const ParsedArgs& args);
 /// --packet K, checked against what `accel` traverses natively.
 int packet_width_from(const ParsedArgs& args, const Accel& accel);

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "accel/bvh/bvh_builders.h"
 #include "app/accel_options.h"
 #include "app/bench_measure.h"
 #include "app/bench_report.h"
@@ -61,13 +62,22 @@ struct BenchPlan {
     std::string rays_file;
     int repeat = 5, width = 512, height = 512;
     OffsetPolicy offset = kDefaultOffset;
+    KernelChoice kernels;        ///< --triangle, --sphere, --slabs, --precision, --rcp (not Embree's)
+    std::string builder = "binned";  ///< --builder, for bvh2, bvh4, bvh8
     bool quick = false;
+
+    AccelConfig config(const std::string& kind) const {
+        AccelConfig c = accel_config(kind, kernels);
+        c.builder = builder;
+        return c;
+    }
 };
 
 void print_help() {
     std::printf(
         "usage: raypack bench [SCENE...] [--accel LIST] [--packet LIST] [--rays KINDS | --rays-file FILE]\n"
         "                     [--threads LIST] [--repeat R] [--res W H] [--offset POLICY] [--json FILE] [--csv FILE]\n"
+        "                     [--builder B] [--triangle T] [--sphere S] [--slabs S] [--precision P] [--rcp R]\n"
         "                     [--quick]\n"
         "       raypack bench --tradeoff [--quick] [--repeat R] [--json FILE] [--csv FILE]\n"
         "  SCENE          .nff, .obj or gen:NAME:SIZE (default gen:balls:4)\n"
@@ -84,10 +94,13 @@ void print_help() {
         "  --quick        every structure (brute too), width and ray kind on gen:balls:3 at 256x256,\n"
         "                 repeat 3: the CI smoke run; explicit options still apply\n"
         "  --offset P     secondary-ray origins of the shadow and diffuse sets: %s (default %s)\n"
+        "  --builder B    BVH builder of bvh2, bvh4, bvh8: %s (default binned)\n"
+        "  kernel variants of every structure but Embree (which runs its own):\n%s"
         "  --tradeoff     speed against accuracy of each kernel and offset variant: throughput, leaks\n"
         "                 at shared edges and vertices, t error in ULPs, self-intersections from\n"
         "                 scale 1e-4 to 1e6, image error against a double reference (README)\n",
-        accel_kinds_list().c_str(), offset_policy_list().c_str(), offset_policy_name(kDefaultOffset));
+        accel_kinds_list().c_str(), offset_policy_list().c_str(), offset_policy_name(kDefaultOffset),
+        bvh_builder_list().c_str(), kernel_options_help().c_str());
 }
 
 BenchPlan plan_from(const ParsedArgs& p) {
@@ -127,6 +140,12 @@ BenchPlan plan_from(const ParsedArgs& p) {
             throw UsageError("--rays: expected camera, shadow or diffuse, got '" + k + "'");
     if (!plan.rays_file.empty()) plan.ray_kinds = {"file"};
     plan.offset = offset_policy_from(p);
+    plan.kernels = kernel_choice_from(p);
+    if (p.has("--builder")) {
+        plan.builder = p.text("--builder");
+        if (!is_bvh_builder(plan.builder))
+            throw UsageError("--builder: unknown builder '" + plan.builder + "' (expected " + bvh_builder_list() + ")");
+    }
     return plan;
 }
 
@@ -169,23 +188,26 @@ std::size_t count_cases(const BenchPlan& plan) {
     std::size_t per_scene = 0;
     std::vector<std::string> ignored;
     for (const std::string& a : plan.accels)
-        per_scene += packet_widths(plan, *build_accel(probe, accel_config(a)), ignored).size();
+        per_scene += packet_widths(plan, *build_accel(probe, plan.config(a)), ignored).size();
     return per_scene * plan.scenes.size() * plan.ray_kinds.size() * plan.threads.size();
 }
 
 }  // namespace
 
 int run_bench(const Args& args) {
-    const ParsedArgs p(args, {{"--accel", "", 1}, {"--packet", "", 1}, {"--rays", "", 1}, {"--rays-file", "", 1},
-                              {"--threads", "", 1}, {"--repeat", "", 1}, {"--res", "", 2}, {"--json", "", 1},
-                              {"--csv", "", 1}, {"--quick", "", 0}, {"--tradeoff", "", 0}, offset_option_spec()},
-                       1000);
+    std::vector<OptionSpec> specs = {{"--accel", "", 1}, {"--packet", "", 1}, {"--rays", "", 1},
+                                     {"--rays-file", "", 1}, {"--threads", "", 1}, {"--repeat", "", 1},
+                                     {"--res", "", 2}, {"--json", "", 1}, {"--csv", "", 1}, {"--quick", "", 0},
+                                     {"--tradeoff", "", 0}, {"--builder", "", 1}, offset_option_spec()};
+    for (OptionSpec& k : kernel_option_specs()) specs.push_back(std::move(k));
+    const ParsedArgs p(args, specs, 1000);
     if (p.help()) {
         print_help();
         return 0;
     }
     if (p.has("--tradeoff")) {
-        for (const char* other : {"--accel", "--packet", "--rays", "--rays-file", "--threads", "--res", "--offset"})
+        for (const char* other : {"--accel", "--packet", "--rays", "--rays-file", "--threads", "--res", "--offset",
+                                  "--builder", "--sphere", "--triangle", "--slabs", "--precision", "--rcp"})
             if (p.has(other)) throw UsageError(std::string(other) + " does not apply to --tradeoff (it runs every variant)");
         if (!p.positional().empty()) throw UsageError("--tradeoff takes no SCENE (it builds its own)");
         return run_tradeoff(TradeoffPlan{.quick = p.has("--quick"),
@@ -196,6 +218,8 @@ int run_bench(const Args& args) {
     Progress progress(count_cases(plan));
     std::vector<BenchRow> rows;
     std::vector<std::string> skipped;
+    std::printf("kernels: %s; builder %s (Embree runs its own)\n", kernel_choice_summary(plan.kernels).c_str(),
+                plan.builder.c_str());
     print_bench_header(stdout);
     for (const std::string& scene_spec : plan.scenes) {
         const Scene scene = load_scene(scene_spec);
@@ -209,7 +233,7 @@ int run_bench(const Args& args) {
             samples.push_back(oracle_sample(scene, sets.back(), kOracleRays));
         }
         for (const std::string& accel_kind : plan.accels) {
-            const auto accel = build_accel(scene, accel_config(accel_kind));
+            const auto accel = build_accel(scene, plan.config(accel_kind));
             const AccelStats& stats = accel->stats();
             const std::vector<int> widths = packet_widths(plan, *accel, skipped);
             for (std::size_t s = 0; s < sets.size(); ++s) {

@@ -2,6 +2,8 @@
 // Axis-aligned boxes and the slab test (Kay & Kajiya 1986), written once for
 // every lane type (see kernels/simd.h): K rays against one box, or one ray
 // against K boxes stored as SoA.
+#include <immintrin.h>
+
 #include <cmath>
 #include <limits>
 #include <utility>
@@ -55,6 +57,33 @@ RAYPACK_INLINE Vec3<F> reciprocal(const Vec3<F>& d) {
     const F tiny(kMinRcpInput);
     auto safe = [&](const F& c) { return select(vabs(c) < tiny, copysign_of(tiny, c), c); };
     return {F(1) / safe(d.x), F(1) / safe(d.y), F(1) / safe(d.z)};
+}
+
+/// How reciprocal directions are computed (`--rcp`): exactly, by division,
+/// or from the hardware estimate plus one Newton-Raphson step.
+enum class RcpMethod { Exact, Approx };
+
+/// 1/x from the hardware estimate (rcp14, 14 bits, with AVX-512; rcpss,
+/// 12 bits, otherwise) refined by one Newton-Raphson step,
+/// r1 = r0 + r0 (1 - x r0), as Embree's rcp() does: within a few ulps of
+/// 1/x, not correctly rounded, so the robust slab test's widening by
+/// 1 + 2 gamma(3) no longer covers every rounding (the trade --rcp measures).
+inline float approx_reciprocal(float x) {
+#if defined(__AVX512F__)
+    const float r0 = _mm_cvtss_f32(_mm_rcp14_ss(_mm_setzero_ps(), _mm_set_ss(x)));
+#else
+    const float r0 = _mm_cvtss_f32(_mm_rcp_ss(_mm_set_ss(x)));
+#endif
+    return std::fma(r0, std::fma(-x, r0, 1.0f), r0);
+}
+
+/// reciprocal() by the method `--rcp` names; rays compute it once, at width 1,
+/// so packets and single rays get the same bits either way.
+inline Vec3f reciprocal(const Vec3f& d, RcpMethod method) {
+    if (method == RcpMethod::Exact) return reciprocal(d);
+    const float tiny = kMinRcpInput;
+    auto safe = [&](float c) { return std::fabs(c) < tiny ? std::copysign(tiny, c) : c; };
+    return {approx_reciprocal(safe(d.x)), approx_reciprocal(safe(d.y)), approx_reciprocal(safe(d.z))};
 }
 
 /// What a slab test needs of a ray: origin, reciprocal direction and, for the
