@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <limits>
 #include <span>
+#include <utility>
 
 #include "kernels/ray_packet.h"
 
@@ -12,13 +13,14 @@ namespace raypack {
 
 /// `trace_packet(ray, hit, valid, occluded)` traces one packet: it records
 /// closest hits in `hit`, or sets the `occluded` lanes for any-hit queries.
+/// `rcp` computes the packets' reciprocal directions (`--rcp`).
 template <int K, bool AnyHit, class TracePacket>
-void trace_in_packets(std::span<const Rayf> rays, std::span<Hitf> hits, TracePacket&& trace_packet) {
+void trace_in_packets(std::span<const Rayf> rays, std::span<Hitf> hits, RcpMethod rcp, TracePacket&& trace_packet) {
     using F = vfloat<K>;
     for (std::size_t first = 0; first < rays.size(); first += K) {
         const std::size_t n = std::min<std::size_t>(K, rays.size() - first);
         vmask<K> valid;
-        RayPacket<K> ray = load_packet<K>(rays.subspan(first, n), valid);
+        RayPacket<K> ray = load_packet<K>(rays.subspan(first, n), valid, rcp);
         HitPacket<K> hit;
         hit.t = F(std::numeric_limits<float>::infinity());
         hit.u = hit.v = F(0.0f);
@@ -39,6 +41,12 @@ void trace_in_packets(std::span<const Rayf> rays, std::span<Hitf> hits, TracePac
             }
         }
     }
+}
+
+/// Exact reciprocals (the callers that do not take `--rcp` yet).
+template <int K, bool AnyHit, class TracePacket>
+void trace_in_packets(std::span<const Rayf> rays, std::span<Hitf> hits, TracePacket&& trace_packet) {
+    trace_in_packets<K, AnyHit>(rays, hits, RcpMethod::Exact, std::forward<TracePacket>(trace_packet));
 }
 
 }  // namespace raypack

@@ -30,16 +30,17 @@ template <int K> using RayPacket = RayLanes<vfloat<K>>;
 template <int K> using HitPacket = HitLanes<vfloat<K>>;
 
 /// Loads up to K rays (count <= K) into a packet; the lanes past `count`
-/// repeat the last ray and come back inactive in `valid`.
+/// repeat the last ray and come back inactive in `valid`. rdir is computed
+/// per ray, at width 1, by `rcp` (`--rcp`), so lanes get the single ray's bits.
 template <int K>
-RayPacket<K> load_packet(std::span<const Rayf> rays, vmask<K>& valid) {
+RayPacket<K> load_packet(std::span<const Rayf> rays, vmask<K>& valid, RcpMethod rcp = RcpMethod::Exact) {
     using F = vfloat<K>;
     alignas(64) float f[11][K];
     alignas(64) float active[K];
     const std::size_t n = rays.size();
     for (int i = 0; i < K; ++i) {
         const Rayf& r = rays[std::min<std::size_t>(std::size_t(i), n - 1)];
-        const Vec3f rd = reciprocal(r.dir);
+        const Vec3f rd = reciprocal(r.dir, rcp);
         const float vals[11] = {r.org.x, r.org.y, r.org.z, r.dir.x, r.dir.y, r.dir.z, rd.x, rd.y, rd.z, r.tnear, r.tfar};
         for (int c = 0; c < 11; ++c) f[c][i] = vals[c];
         active[i] = std::size_t(i) < n ? 1.0f : 0.0f;

@@ -28,27 +28,27 @@ Bvh2Accel::Bvh2Accel(const Scene& scene, const AccelConfig& config) : scene_(&sc
     stats_.refs_per_prim = stats_.primitives ? double(bvh_.prim_index.size()) / double(stats_.primitives) : 1.0;
 }
 
-template <bool AnyHit>
-bool Bvh2Accel::trace(Rayf& ray, Hitf& hit) const {
-    if (bvh_.nodes.empty()) return false;
-    return trace_bvh2_subtree<AnyHit>(bvh_, PrimitiveIntersector<float>{scene_, kernels_}, 0, ray, hit);
+template <bool AnyHit, class Out>
+void Bvh2Accel::trace(std::span<const Rayf> rays, Out&& out) const {
+    const PrimitiveIntersector<float> isect{scene_, kernels_};
+    auto run = [&]<SlabMethod Slabs>() {
+        for (std::size_t i = 0; i < rays.size(); ++i) {
+            Rayf ray = rays[i];
+            Hitf hit;
+            const bool found = !bvh_.nodes.empty() && trace_bvh2_subtree<AnyHit, Slabs>(bvh_, isect, 0, ray, hit);
+            out(i, found, hit);
+        }
+    };
+    if (kernels_.slabs == SlabMethod::Plain) return run.template operator()<SlabMethod::Plain>();
+    run.template operator()<SlabMethod::Robust>();
 }
 
 void Bvh2Accel::intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const {
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-        Rayf ray = rays[i];
-        Hitf hit;
-        trace<false>(ray, hit);
-        hits[i] = hit;
-    }
+    trace<false>(rays, [&](std::size_t i, bool, const Hitf& hit) { hits[i] = hit; });
 }
 
 void Bvh2Accel::occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const {
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-        Rayf ray = rays[i];
-        Hitf hit;
-        occluded[i] = trace<true>(ray, hit) ? 1 : 0;
-    }
+    trace<true>(rays, [&](std::size_t i, bool found, const Hitf&) { occluded[i] = found ? 1 : 0; });
 }
 
 bool Bvh2Accel::supports_packet(int width) const {

@@ -18,8 +18,10 @@ public:
     const Bvh2& bvh() const { return bvh_; }
 
 private:
-    template <bool AnyHit>
-    bool trace(Rayf& ray, Hitf& hit) const;
+    /// Every ray of the batch, with the slab test `--slabs` names (chosen
+    /// once per batch): out(i, found, hit).
+    template <bool AnyHit, class Out>
+    void trace(std::span<const Rayf> rays, Out&& out) const;
     template <bool AnyHit>
     void trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const;
 

@@ -25,7 +25,7 @@ inline constexpr int kSwitchBelow = 2;
 
 /// The lanes of `lanes` trace the subtree under `root` one by one, from the
 /// packet's current state; their hits (and tfar) go back into the packet.
-template <int K, bool AnyHit>
+template <int K, bool AnyHit, SlabMethod Slabs>
 void finish_lanes_alone(const Bvh2& bvh, const PrimitiveIntersector<float>& single, std::uint32_t root,
                         std::uint32_t lanes, RayPacket<K>& ray, HitPacket<K>& hit, vmask<K>& valid,
                         vmask<K>& occluded) {
@@ -41,7 +41,7 @@ void finish_lanes_alone(const Bvh2& bvh, const PrimitiveIntersector<float>& sing
         Rayf r;
         r.org = {ox[l], oy[l], oz[l]}, r.dir = {dx[l], dy[l], dz[l]}, r.tnear = tn[l], r.tfar = tf[l];
         Hitf h{ht[l], hit.prim[l], hu[l], hv[l]};
-        if (!trace_bvh2_subtree<AnyHit>(bvh, single, root, r, h)) continue;
+        if (!trace_bvh2_subtree<AnyHit, Slabs>(bvh, single, root, r, h)) continue;
         ht[l] = h.t, hit.prim[l] = h.prim, hu[l] = h.u, hv[l] = h.v, tf[l] = r.tfar;
         stopped |= 1u << l;
     }
@@ -56,7 +56,9 @@ void finish_lanes_alone(const Bvh2& bvh, const PrimitiveIntersector<float>& sing
     }
 }
 
-template <int K, bool AnyHit>
+/// Slabs: the box test `--slabs` names, lane for lane the single ray's
+/// (bvh2_traversal.h), on the reciprocal load_packet computed per ray.
+template <int K, bool AnyHit, SlabMethod Slabs>
 void trace_packet(const Bvh2& bvh, const PacketPrimitiveIntersector<vfloat<K>>& isect,
                   const PrimitiveIntersector<float>& single, RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid,
                   vmask<K>& occluded) {
@@ -66,7 +68,7 @@ void trace_packet(const Bvh2& bvh, const PacketPrimitiveIntersector<vfloat<K>>& 
     SlabRay<F> slab = make_slab_ray(ray.org, ray.rdir, ray.tnear, ray.tfar);
     auto box_test = [&](const M& active, std::uint32_t n, F& entry) {
         const Box3f& b = nodes[n].box;
-        return intersect_box<SlabMethod::Robust, F>(active, slab, splat<F>(b.lo), splat<F>(b.hi), entry);
+        return intersect_box<Slabs, F>(active, slab, splat<F>(b.lo), splat<F>(b.hi), entry);
     };
     F entry;
     M active = box_test(valid, 0, entry);
@@ -77,7 +79,7 @@ void trace_packet(const Bvh2& bvh, const PacketPrimitiveIntersector<vfloat<K>>& 
     for (;;) {
         const Bvh2Node& node = nodes[current];
         if (const std::uint32_t lanes = mask_bits(active); std::popcount(lanes) < kSwitchBelow<K>) {
-            finish_lanes_alone<K, AnyHit>(bvh, single, current, lanes, ray, hit, valid, occluded);
+            finish_lanes_alone<K, AnyHit, Slabs>(bvh, single, current, lanes, ray, hit, valid, occluded);
             slab.tfar = ray.tfar;
             if constexpr (AnyHit)
                 if (none(valid)) return;
@@ -142,10 +144,14 @@ void bvh2_trace_packets(const Bvh2& bvh, const Scene& scene, KernelChoice kernel
     }
     const PacketPrimitiveIntersector<F> isect{&scene, kernels};
     const PrimitiveIntersector<float> single{&scene, kernels};
-    trace_in_packets<K, AnyHit>(rays, hits, [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid,
-                                                vmask<K>& occluded) {
-        trace_packet<K, AnyHit>(bvh, isect, single, ray, hit, valid, occluded);
-    });
+    auto run = [&]<SlabMethod Slabs>() {
+        trace_in_packets<K, AnyHit>(rays, hits, kernels.rcp, [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid,
+                                                                 vmask<K>& occluded) {
+            trace_packet<K, AnyHit, Slabs>(bvh, isect, single, ray, hit, valid, occluded);
+        });
+    };
+    if (kernels.slabs == SlabMethod::Plain) return run.template operator()<SlabMethod::Plain>();
+    run.template operator()<SlabMethod::Robust>();
 }
 
 #if defined(__SSE4_2__)

@@ -31,7 +31,7 @@ WideBvhAccel<N, M, Test>::WideBvhAccel(const Scene& scene, const AccelConfig& co
 
 template <int N, int M, NodeTest Test>
 WideBvhAccel<N, M, Test>::WideBvhAccel(const Scene& scene, const AccelConfig& config, const CollapseConfig& collapse)
-    : kernels_(config.kernels) {
+    : scene_(&scene), kernels_(config.kernels) {
     const auto start = std::chrono::steady_clock::now();
     const Bvh2 binary = build_scene_bvh2(scene, config);
     CollapseConfig cc = collapse;
@@ -53,17 +53,24 @@ WideBvhAccel<N, M, Test>::WideBvhAccel(const Scene& scene, const AccelConfig& co
 template <int N, int M, NodeTest Test>
 template <bool AnyHit, class Out>
 void WideBvhAccel<N, M, Test>::trace(std::span<const Rayf> rays, Out&& out) const {
-    auto run = [&]<TriangleMethod TM>() {
+    // Variants chosen once per batch: the triangle kernel and precision by
+    // template, slabs and rcp in each ray's setup (make_node_ray).
+    const PrimitiveIntersector<float> isect{scene_, kernels_};
+    auto run = [&]<TriangleMethod TM, bool ByPrim>() {
         for (std::size_t i = 0; i < rays.size(); ++i) {
             Hitf hit;
-            const bool any = trace_wide<N, M, TM, Test, AnyHit>(bvh_, kernels_.sphere, rays[i], hit);
+            const bool any = trace_wide<N, M, TM, Test, AnyHit, ByPrim>(bvh_, kernels_.sphere, rays[i], hit,
+                                                                        kernels_.slabs, kernels_.rcp, &isect);
             out(i, any, hit);
         }
     };
+    // Double: the block kernels are not used, so one instantiation serves
+    // every triangle method (PrimitiveIntersector runs the chosen one).
+    if (kernels_.precision == Precision::Double) return run.template operator()<TriangleMethod::Moeller, true>();
     switch (kernels_.triangle) {
-        case TriangleMethod::Moeller: return run.template operator()<TriangleMethod::Moeller>();
-        case TriangleMethod::Watertight: return run.template operator()<TriangleMethod::Watertight>();
-        case TriangleMethod::Plane: return run.template operator()<TriangleMethod::Plane>();
+        case TriangleMethod::Moeller: return run.template operator()<TriangleMethod::Moeller, false>();
+        case TriangleMethod::Watertight: return run.template operator()<TriangleMethod::Watertight, false>();
+        case TriangleMethod::Plane: return run.template operator()<TriangleMethod::Plane, false>();
     }
 }
 
@@ -110,11 +117,11 @@ void WideBvhAccel<N, M, Test>::trace_packets(int width, std::span<const Rayf> ra
     if constexpr (kPackets) {
         const WidePacketConfig& c = packet_config_[packet_slot(width)];
         if constexpr (kWidthCompiled<4>)
-            if (width == 4) return wide_trace_packets<N, M, 4, AnyHit>(bvh_, kernels_, c, rays, hits);
+            if (width == 4) return wide_trace_packets<N, M, 4, AnyHit>(bvh_, *scene_, kernels_, c, rays, hits);
         if constexpr (kWidthCompiled<8>)
-            if (width == 8) return wide_trace_packets<N, M, 8, AnyHit>(bvh_, kernels_, c, rays, hits);
+            if (width == 8) return wide_trace_packets<N, M, 8, AnyHit>(bvh_, *scene_, kernels_, c, rays, hits);
         if constexpr (kWidthCompiled<16>)
-            if (width == 16) return wide_trace_packets<N, M, 16, AnyHit>(bvh_, kernels_, c, rays, hits);
+            if (width == 16) return wide_trace_packets<N, M, 16, AnyHit>(bvh_, *scene_, kernels_, c, rays, hits);
     }
     throw std::invalid_argument(stats_.name + ": packets of " + std::to_string(width) + " are not compiled in");
 }

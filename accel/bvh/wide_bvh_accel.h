@@ -23,7 +23,8 @@ public:
     const WideBvh<N, M>& bvh() const { return bvh_; }
 
     /// Packets of 4, 8, 16 (as compiled in) for the Ordered node test and
-    /// blocks of 8 (accel/bvh/wide_packet.h); other variants trace single rays.
+    /// blocks of 8 (accel/bvh/wide_packet.h), whatever the kernel variants;
+    /// other node tests and block sizes trace single rays.
     bool supports_packet(int width) const override;
     void intersect_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const override;
     void occluded_packets(int width, std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override;
@@ -42,6 +43,7 @@ private:
     void trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const;
 
     static constexpr bool kPackets = M == 8 && Test == NodeTest::Ordered;
+    const Scene* scene_;  ///< --precision double tests leaves' primitives by id
     KernelChoice kernels_;
     WidePacketConfig packet_config_[3] = {{default_wide_switch_below(N, 4)}, {default_wide_switch_below(N, 8)},
                                           {default_wide_switch_below(N, 16)}};  ///< K = 4, 8, 16

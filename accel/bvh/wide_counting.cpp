@@ -17,44 +17,47 @@ std::uint32_t valid_lanes(const Block& b) {
 template <int N, int M, TriangleMethod TM, NodeTest Test, bool AnyHit>
 struct WideCountingWalk {
     const WideBvh<N, M>& bvh;
-    SphereMethod sphere_method;
+    KernelChoice kernels;
+    const PrimitiveIntersector<float>* by_prim;  ///< --precision double: leaves test primitives by id
     TraversalCounts& counts;
 
     /// One run of blocks, a kernel call per block; true if something was hit.
     template <class Block>
-    bool run(const Block* blocks, std::uint32_t count, const LeafRay<vfloat<M>>& r, float& tfar, Hitf& hit) const {
+    bool run(const Block* blocks, std::uint32_t count, const LeafRay<vfloat<M>>& r, const Rayf& ray, float& tfar,
+             Hitf& hit) const {
         bool found = false;
         for (std::uint32_t k = 0; k < count; ++k) {
             counts.prims += valid_lanes<M>(blocks[k]);
-            found |= intersect_run<TM, AnyHit>(blocks + k, 1, sphere_method, r, tfar, hit);
+            if (by_prim) found |= intersect_run_by_prim<AnyHit>(blocks + k, 1, PrimLeafRay{by_prim, ray}, tfar, hit);
+            else found |= intersect_run<TM, AnyHit>(blocks + k, 1, kernels.sphere, r, tfar, hit);
             if (AnyHit && found) return true;
         }
         return found;
     }
 
-    bool leaf(std::uint32_t code, const LeafRay<vfloat<M>>& r, float& tfar, Hitf& hit) const {
+    bool leaf(std::uint32_t code, const LeafRay<vfloat<M>>& r, const Rayf& ray, float& tfar, Hitf& hit) const {
         ++counts.nodes;
         const std::uint32_t first = wide_child::first(code), count = wide_child::blocks(code);
         switch (wide_child::kind(code)) {
-            case LeafKind::Triangle: return run(bvh.triangles.data() + first, count, r, tfar, hit);
-            case LeafKind::Sphere: return run(bvh.spheres.data() + first, count, r, tfar, hit);
-            case LeafKind::Cone: return run(bvh.cones.data() + first, count, r, tfar, hit);
+            case LeafKind::Triangle: return run(bvh.triangles.data() + first, count, r, ray, tfar, hit);
+            case LeafKind::Sphere: return run(bvh.spheres.data() + first, count, r, ray, tfar, hit);
+            case LeafKind::Cone: return run(bvh.cones.data() + first, count, r, ray, tfar, hit);
             case LeafKind::Mixed: break;
         }
         const MixedLeaf& m = bvh.mixed[first];
         constexpr int tri = int(LeafKind::Triangle), sph = int(LeafKind::Sphere), cone = int(LeafKind::Cone);
-        bool found = run(bvh.triangles.data() + m.first[tri], m.count[tri], r, tfar, hit);
+        bool found = run(bvh.triangles.data() + m.first[tri], m.count[tri], r, ray, tfar, hit);
         if (AnyHit && found) return true;
-        found |= run(bvh.spheres.data() + m.first[sph], m.count[sph], r, tfar, hit);
+        found |= run(bvh.spheres.data() + m.first[sph], m.count[sph], r, ray, tfar, hit);
         if (AnyHit && found) return true;
-        return run(bvh.cones.data() + m.first[cone], m.count[cone], r, tfar, hit) || found;
+        return run(bvh.cones.data() + m.first[cone], m.count[cone], r, ray, tfar, hit) || found;
     }
 
     /// trace_wide with counters: the same pushes, order and pops.
     bool trace(const Rayf& ray, Hitf& hit) const {
         using F = vfloat<N>;
         if (bvh.nodes.empty()) return false;
-        const NodeRay<N> nr = make_node_ray<Test, N>(ray);
+        const NodeRay<N> nr = make_node_ray<Test, N>(ray, kernels.slabs, kernels.rcp);
         const LeafRay<vfloat<M>> lr = make_leaf_ray<vfloat<M>>(ray, TM);
         float tfar = ray.tfar;
         WideStackEntry stack[(N - 1) * kBvhMaxDepth + 1];
@@ -95,7 +98,7 @@ struct WideCountingWalk {
                     cur = (--sp)->node;
                 }
             }
-            if (descend && leaf(cur, lr, tfar, hit)) {
+            if (descend && leaf(cur, lr, ray, tfar, hit)) {
                 found = true;
                 if constexpr (AnyHit) return true;
             }
@@ -115,7 +118,9 @@ template <int N, int M, NodeTest Test>
 bool WideBvhAccel<N, M, Test>::count_traversal(std::span<const Rayf> rays, bool any_hit, std::span<Hitf> hits,
                                                TraversalCounts& counts) const {
     auto run = [&]<TriangleMethod TM, bool AnyHit>() {
-        const WideCountingWalk<N, M, TM, Test, AnyHit> walk{bvh_, kernels_.sphere, counts};
+        const PrimitiveIntersector<float> isect{scene_, kernels_};
+        const bool by_prim = kernels_.precision == Precision::Double;
+        const WideCountingWalk<N, M, TM, Test, AnyHit> walk{bvh_, kernels_, by_prim ? &isect : nullptr, counts};
         for (std::size_t i = 0; i < rays.size(); ++i) {
             Hitf hit;
             const bool found = walk.trace(rays[i], hit);

@@ -13,6 +13,7 @@
 #include "accel/bvh/wide_bvh.h"
 #include "accel/primitive_intersector.h"
 #include "kernels/ray.h"
+#include "scene/scene.h"
 
 namespace raypack {
 
@@ -40,8 +41,10 @@ constexpr int default_wide_switch_below(int n, int k) {
 /// Closest hits (AnyHit = false) or occlusion (AnyHit = true: hits[i].prim
 /// = 0 where occluded) of `rays` in packets of K consecutive rays. Defined
 /// for N = 4, 8 with M = 8 and the K that are compiled in (kWidthCompiled).
+/// `scene` is the one the tree was built over (--precision double tests
+/// leaves' primitives by id).
 template <int N, int M, int K, bool AnyHit>
-void wide_trace_packets(const WideBvh<N, M>& bvh, KernelChoice kernels, const WidePacketConfig& config,
-                        std::span<const Rayf> rays, std::span<Hitf> hits);
+void wide_trace_packets(const WideBvh<N, M>& bvh, const Scene& scene, KernelChoice kernels,
+                        const WidePacketConfig& config, std::span<const Rayf> rays, std::span<Hitf> hits);
 
 }  // namespace raypack

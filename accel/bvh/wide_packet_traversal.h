@@ -34,6 +34,7 @@
 #include "accel/bvh/wide_packet.h"
 #include "accel/bvh/wide_traversal.h"
 #include "accel/packet_driver.h"
+#include "accel/packet_intersector.h"
 #include "kernels/ray_packet.h"
 
 namespace raypack::wide_packet_detail {
@@ -62,22 +63,29 @@ struct PacketNodeRay {
 };
 
 /// make_node_ray<NodeTest::Ordered> (accel/bvh/wide_node_test.h) for K
-/// lanes: the same reciprocal, the same +-inf for a clamped component, the
-/// same widened far reciprocal.
+/// lanes: the same reciprocal (load_packet's, computed per ray by `--rcp`;
+/// unclamped it is 1 / d, the single ray's bits), the same +-inf for a
+/// clamped component, the same far reciprocal (widened unless `slabs` is
+/// Plain).
 template <int K>
-RAYPACK_INLINE PacketNodeRay<K> make_packet_node_ray(const RayPacket<K>& p) {
+RAYPACK_INLINE PacketNodeRay<K> make_packet_node_ray(const RayPacket<K>& p, SlabMethod slabs) {
     using F = vfloat<K>;
     const F inf(std::numeric_limits<float>::infinity());
     PacketNodeRay<K> n;
-    auto axis = [&](const F& d, F& r, F& r_far, vmask<K>& negative) {
-        r = select(vabs(d) < F(kMinRcpInput), copysign_of(inf, d), F(1.0f) / d);
-        const F w = r * F(kFarWiden);
-        r_far = select(vabs(w) == inf, w, next_away_from_zero(w));
+    const bool widen = slabs == SlabMethod::Robust;
+    auto axis = [&](const F& d, const F& rd, F& r, F& r_far, vmask<K>& negative) {
+        r = select(vabs(d) < F(kMinRcpInput), copysign_of(inf, d), rd);
+        if (widen) {
+            const F w = r * F(kFarWiden);
+            r_far = select(vabs(w) == inf, w, next_away_from_zero(w));
+        } else {
+            r_far = r;
+        }
         negative = r < F(0.0f);
     };
-    axis(p.dir.x, n.rdir.x, n.rdir_far.x, n.neg_x);
-    axis(p.dir.y, n.rdir.y, n.rdir_far.y, n.neg_y);
-    axis(p.dir.z, n.rdir.z, n.rdir_far.z, n.neg_z);
+    axis(p.dir.x, p.rdir.x, n.rdir.x, n.rdir_far.x, n.neg_x);
+    axis(p.dir.y, p.rdir.y, n.rdir.y, n.rdir_far.y, n.neg_y);
+    axis(p.dir.z, p.rdir.z, n.rdir.z, n.rdir_far.z, n.neg_z);
     n.org = p.org;
     n.tnear = p.tnear;
     return n;
@@ -227,6 +235,54 @@ RAYPACK_INLINE void packet_leaf(const WideBvh<N, M>& bvh, SphereMethod sm, std::
     packet_run<TM, AnyHit>(bvh.cones.data() + m.first[cone], m.count[cone], sm, r, active & s.valid, s);
 }
 
+/// packet_leaf for --precision double: each primitive of the leaf's blocks,
+/// by id, through PacketPrimitiveIntersector (double, lane by lane).
+template <bool AnyHit, int N, int M, int K>
+inline void packet_leaf_by_prim(const WideBvh<N, M>& bvh, const PacketPrimitiveIntersector<vfloat<K>>& isect,
+                                std::uint32_t code, const RayPacket<K>& ray, vmask<K> active, PacketState<K>& s) {
+    using F = vfloat<K>;
+    const F minus_inf(-std::numeric_limits<float>::infinity());
+    RayPacket<K> r = ray;
+    auto run = [&](const auto* b, std::uint32_t count) {
+        constexpr int BM = int(sizeof(b->prim) / sizeof(b->prim[0]));
+        for (; count != 0; --count, ++b) {
+            for (int j = 0; j < BM && b->prim[j] != kNoPrim; ++j) {
+                if (none(active)) return;
+                r.tfar = s.tfar;
+                const vmask<K> m = isect.intersect(active, r, s.hit, b->prim[j]);
+                if constexpr (AnyHit) {
+                    s.occluded = s.occluded | m;
+                    s.valid = s.valid & !m;
+                    s.tfar = select(m, minus_inf, s.tfar);
+                    active = active & !m;
+                } else {
+                    s.tfar = r.tfar;
+                }
+            }
+        }
+    };
+    const std::uint32_t first = wide_child::first(code), count = wide_child::blocks(code);
+    switch (wide_child::kind(code)) {
+        case LeafKind::Triangle: return run(bvh.triangles.data() + first, count);
+        case LeafKind::Sphere: return run(bvh.spheres.data() + first, count);
+        case LeafKind::Cone: return run(bvh.cones.data() + first, count);
+        case LeafKind::Mixed: break;
+    }
+    const MixedLeaf& m = bvh.mixed[first];
+    run(bvh.triangles.data() + m.first[int(LeafKind::Triangle)], m.count[int(LeafKind::Triangle)]);
+    run(bvh.spheres.data() + m.first[int(LeafKind::Sphere)], m.count[int(LeafKind::Sphere)]);
+    run(bvh.cones.data() + m.first[int(LeafKind::Cone)], m.count[int(LeafKind::Cone)]);
+}
+
+/// What the packet traversal needs beyond the tree: the kernel variants and,
+/// for --precision double (ByPrim), the primitive intersectors.
+template <int K>
+struct PacketKernels {
+    KernelChoice kernels;
+    PrimitiveIntersector<float> single;
+    PacketPrimitiveIntersector<vfloat<K>> packet;
+};
+
 /// The lanes `bits` as a mask.
 template <int K>
 RAYPACK_INLINE vmask<K> mask_from_bits(std::uint32_t bits) {
@@ -237,8 +293,8 @@ RAYPACK_INLINE vmask<K> mask_from_bits(std::uint32_t bits) {
 
 /// The lanes `bits` finish the subtree under `root` one ray at a time
 /// (Benthin et al. 2012), each from its own closest hit so far.
-template <int N, int M, int K, TriangleMethod TM, bool AnyHit>
-void lanes_alone(const WideBvh<N, M>& bvh, SphereMethod sm, std::uint32_t root, std::uint32_t bits,
+template <int N, int M, int K, TriangleMethod TM, bool AnyHit, bool ByPrim>
+void lanes_alone(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, std::uint32_t root, std::uint32_t bits,
                  const RayPacket<K>& ray, PacketState<K>& s) {
     using F = vfloat<K>;
     alignas(64) float org[3][K], dir[3][K], tnear[K], tfar[K], t[K], u[K], v[K];
@@ -261,9 +317,17 @@ void lanes_alone(const WideBvh<N, M>& bvh, SphereMethod sm, std::uint32_t root, 
         r.tfar = tfar[i];
         Hitf h{t[i], s.hit.prim[i], u[i], v[i]};
         float lane_tfar = tfar[i];
-        if (!trace_wide_subtree<N, M, TM, NodeTest::Ordered, AnyHit>(
-                bvh, sm, root, make_node_ray<NodeTest::Ordered, N>(r), make_leaf_ray<vfloat<M>>(r, TM), lane_tfar, h))
-            continue;
+        const NodeRay<N> nr = make_node_ray<NodeTest::Ordered, N>(r, pk.kernels.slabs, pk.kernels.rcp);
+        bool lane_hit;
+        if constexpr (ByPrim) {
+            const PrimLeafRay p{&pk.single, r};
+            lane_hit = trace_wide_subtree<N, M, TM, NodeTest::Ordered, AnyHit, true>(
+                bvh, pk.kernels.sphere, root, nr, LeafRay<vfloat<M>>{}, lane_tfar, h, &p);
+        } else {
+            lane_hit = trace_wide_subtree<N, M, TM, NodeTest::Ordered, AnyHit>(
+                bvh, pk.kernels.sphere, root, nr, make_leaf_ray<vfloat<M>>(r, TM), lane_tfar, h);
+        }
+        if (!lane_hit) continue;
         if constexpr (AnyHit) {
             occluded |= 1u << i;
             tfar[i] = -std::numeric_limits<float>::infinity();
@@ -290,12 +354,13 @@ void lanes_alone(const WideBvh<N, M>& bvh, SphereMethod sm, std::uint32_t root, 
 }
 
 /// One packet through the tree.
-template <int N, int M, int K, TriangleMethod TM, bool AnyHit>
-void trace_packet(const WideBvh<N, M>& bvh, SphereMethod sm, int switch_below, const RayPacket<K>& ray,
+template <int N, int M, int K, TriangleMethod TM, bool AnyHit, bool ByPrim>
+void trace_packet(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, int switch_below, const RayPacket<K>& ray,
                   HitPacket<K>& hit, vmask<K> valid, vmask<K>& occluded) {
     using F = vfloat<K>;
     using B = vmask<K>;
-    const PacketNodeRay<K> nr = make_packet_node_ray<K>(ray);
+    const SphereMethod sm = pk.kernels.sphere;
+    const PacketNodeRay<K> nr = make_packet_node_ray<K>(ray, pk.kernels.slabs);
     const LeafRay<F> lr = make_packet_leaf_ray<K>(ray, TM);
     PacketState<K> s{hit, ray.tfar, valid, occluded};
     const WideNode<N>* nodes = bvh.nodes.data();
@@ -313,11 +378,12 @@ void trace_packet(const WideBvh<N, M>& bvh, SphereMethod sm, int switch_below, c
         for (;;) {
             const std::uint32_t bits = mask_bits(active);
             if (std::popcount(bits) < switch_below) {
-                lanes_alone<N, M, K, TM, AnyHit>(bvh, sm, cur, bits, ray, s);
+                lanes_alone<N, M, K, TM, AnyHit, ByPrim>(bvh, pk, cur, bits, ray, s);
                 break;
             }
             if (wide_child::is_leaf(cur)) {
-                packet_leaf<TM, AnyHit>(bvh, sm, cur, lr, active, s);
+                if constexpr (ByPrim) packet_leaf_by_prim<AnyHit>(bvh, pk.packet, cur, ray, active, s);
+                else packet_leaf<TM, AnyHit>(bvh, sm, cur, lr, active, s);
                 break;
             }
             const WideNode<N>& node = nodes[cur];
@@ -376,23 +442,27 @@ void trace_packet(const WideBvh<N, M>& bvh, SphereMethod sm, int switch_below, c
 namespace raypack {
 
 template <int N, int M, int K, bool AnyHit>
-void wide_trace_packets(const WideBvh<N, M>& bvh, KernelChoice kernels, const WidePacketConfig& config,
-                        std::span<const Rayf> rays, std::span<Hitf> hits) {
+void wide_trace_packets(const WideBvh<N, M>& bvh, const Scene& scene, KernelChoice kernels,
+                        const WidePacketConfig& config, std::span<const Rayf> rays, std::span<Hitf> hits) {
     if (bvh.nodes.empty()) {
         for (auto& h : hits) h = Hitf{};
         return;
     }
-    auto run = [&]<TriangleMethod TM>() {
-        trace_in_packets<K, AnyHit>(rays, hits, [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid,
-                                                    vmask<K>& occluded) {
-            wide_packet_detail::trace_packet<N, M, K, TM, AnyHit>(bvh, kernels.sphere, config.switch_below, ray, hit,
-                                                                  valid, occluded);
+    const wide_packet_detail::PacketKernels<K> pk{kernels, {&scene, kernels}, {&scene, kernels}};
+    auto run = [&]<TriangleMethod TM, bool ByPrim>() {
+        trace_in_packets<K, AnyHit>(rays, hits, kernels.rcp, [&](RayPacket<K>& ray, HitPacket<K>& hit,
+                                                                 vmask<K> valid, vmask<K>& occluded) {
+            wide_packet_detail::trace_packet<N, M, K, TM, AnyHit, ByPrim>(bvh, pk, config.switch_below, ray, hit,
+                                                                          valid, occluded);
         });
     };
+    // Double: leaves test primitives by id, so one instantiation serves every
+    // triangle method (as in WideBvhAccel::trace).
+    if (kernels.precision == Precision::Double) return run.template operator()<TriangleMethod::Moeller, true>();
     switch (kernels.triangle) {
-        case TriangleMethod::Moeller: return run.template operator()<TriangleMethod::Moeller>();
-        case TriangleMethod::Watertight: return run.template operator()<TriangleMethod::Watertight>();
-        case TriangleMethod::Plane: return run.template operator()<TriangleMethod::Plane>();
+        case TriangleMethod::Moeller: return run.template operator()<TriangleMethod::Moeller, false>();
+        case TriangleMethod::Watertight: return run.template operator()<TriangleMethod::Watertight, false>();
+        case TriangleMethod::Plane: return run.template operator()<TriangleMethod::Plane, false>();
     }
 }
 

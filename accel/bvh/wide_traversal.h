@@ -114,14 +114,63 @@ RAYPACK_INLINE bool intersect_leaf(const WideBvh<N, M>& bvh, SphereMethod sm, st
     return found;
 }
 
+/// --precision double: what a leaf needs to test its blocks' primitives one
+/// by one, by id, through PrimitiveIntersector<float> (which runs them in
+/// double) instead of the float block kernels.
+struct PrimLeafRay {
+    const PrimitiveIntersector<float>* isect;
+    Rayf ray;  ///< tfar is replaced by the current closest hit at each test
+};
+
+template <bool AnyHit, class Block>
+RAYPACK_INLINE bool intersect_run_by_prim(const Block* b, std::uint32_t count, const PrimLeafRay& p, float& tfar,
+                                          Hitf& hit) {
+    constexpr int M = int(sizeof(b->prim) / sizeof(b->prim[0]));
+    bool found = false;
+    for (; count != 0; --count, ++b) {
+        for (int j = 0; j < M && b->prim[j] != kNoPrim; ++j) {  // padding ends a block
+            Rayf r = p.ray;
+            r.tfar = tfar;
+            if (!p.isect->intersect(b->prim[j], r, hit)) continue;
+            if constexpr (AnyHit) return true;
+            found = true;
+            tfar = r.tfar;
+        }
+    }
+    return found;
+}
+
+/// intersect_leaf for --precision double.
+template <bool AnyHit, int N, int M>
+inline bool intersect_leaf_by_prim(const WideBvh<N, M>& bvh, std::uint32_t code, const PrimLeafRay& p, float& tfar,
+                                   Hitf& hit) {
+    const std::uint32_t first = wide_child::first(code), count = wide_child::blocks(code);
+    switch (wide_child::kind(code)) {
+        case LeafKind::Triangle: return intersect_run_by_prim<AnyHit>(bvh.triangles.data() + first, count, p, tfar, hit);
+        case LeafKind::Sphere: return intersect_run_by_prim<AnyHit>(bvh.spheres.data() + first, count, p, tfar, hit);
+        case LeafKind::Cone: return intersect_run_by_prim<AnyHit>(bvh.cones.data() + first, count, p, tfar, hit);
+        case LeafKind::Mixed: break;
+    }
+    const MixedLeaf& m = bvh.mixed[first];
+    constexpr int tri = int(LeafKind::Triangle), sph = int(LeafKind::Sphere), cone = int(LeafKind::Cone);
+    bool found = intersect_run_by_prim<AnyHit>(bvh.triangles.data() + m.first[tri], m.count[tri], p, tfar, hit);
+    if (AnyHit && found) return true;
+    found |= intersect_run_by_prim<AnyHit>(bvh.spheres.data() + m.first[sph], m.count[sph], p, tfar, hit);
+    if (AnyHit && found) return true;
+    found |= intersect_run_by_prim<AnyHit>(bvh.cones.data() + m.first[cone], m.count[cone], p, tfar, hit);
+    return found;
+}
+
 /// One ray through the subtree under child slot `root` (an inner node or a
 /// leaf), with `tfar` the current closest hit distance (shrunk on hits) and
 /// `hit` the current closest hit: the traversal of trace_wide, and the
 /// single-ray fallback of the packet traversal (accel/bvh/wide_packet.h).
-/// True if it found a hit (any hit: returns at the first).
-template <int N, int M, TriangleMethod TM, NodeTest Test, bool AnyHit>
+/// True if it found a hit (any hit: returns at the first). ByPrim: leaves
+/// go through `by_prim` (--precision double), not the block kernels.
+template <int N, int M, TriangleMethod TM, NodeTest Test, bool AnyHit, bool ByPrim = false>
 RAYPACK_INLINE bool trace_wide_subtree(const WideBvh<N, M>& bvh, SphereMethod sphere_method, std::uint32_t root,
-                                       const NodeRay<N>& nr, const LeafRay<vfloat<M>>& lr, float& tfar, Hitf& hit) {
+                                       const NodeRay<N>& nr, const LeafRay<vfloat<M>>& lr, float& tfar, Hitf& hit,
+                                       const PrimLeafRay* by_prim = nullptr) {
     using F = vfloat<N>;
     // Every level but the leaves pushes at most N - 1 entries.
     constexpr int kStackSize = (N - 1) * kBvhMaxDepth + 1;
@@ -180,7 +229,10 @@ RAYPACK_INLINE bool trace_wide_subtree(const WideBvh<N, M>& bvh, SphereMethod sp
                 cur = (--sp)->node;
             }
         }
-        if (intersect_leaf<TM, AnyHit>(bvh, sphere_method, cur, lr, tfar, hit)) {
+        bool leaf_hit;
+        if constexpr (ByPrim) leaf_hit = intersect_leaf_by_prim<AnyHit>(bvh, cur, *by_prim, tfar, hit);
+        else leaf_hit = intersect_leaf<TM, AnyHit>(bvh, sphere_method, cur, lr, tfar, hit);
+        if (leaf_hit) {
             found = true;
             if constexpr (AnyHit) return true;
             tfar_v = F(node_tfar(tfar));
@@ -197,13 +249,23 @@ RAYPACK_INLINE bool trace_wide_subtree(const WideBvh<N, M>& bvh, SphereMethod sp
 
 /// Closest hit (AnyHit = false: `hit` gets the nearest, the return value
 /// says whether there is one) or any hit (returns true at the first) of one
-/// ray in [tnear, tfar].
-template <int N, int M, TriangleMethod TM, NodeTest Test, bool AnyHit>
-bool trace_wide(const WideBvh<N, M>& bvh, SphereMethod sphere_method, const Rayf& ray, Hitf& hit) {
+/// ray in [tnear, tfar], with the node test variants `slabs`, `rcp` (see
+/// make_node_ray); ByPrim (--precision double) tests leaves through `isect`.
+template <int N, int M, TriangleMethod TM, NodeTest Test, bool AnyHit, bool ByPrim = false>
+bool trace_wide(const WideBvh<N, M>& bvh, SphereMethod sphere_method, const Rayf& ray, Hitf& hit,
+                SlabMethod slabs = SlabMethod::Robust, RcpMethod rcp = RcpMethod::Exact,
+                const PrimitiveIntersector<float>* isect = nullptr) {
     if (bvh.nodes.empty()) return false;
     float tfar = ray.tfar;
-    return trace_wide_subtree<N, M, TM, Test, AnyHit>(bvh, sphere_method, 0, make_node_ray<Test, N>(ray),
-                                                      make_leaf_ray<vfloat<M>>(ray, TM), tfar, hit);
+    const NodeRay<N> nr = make_node_ray<Test, N>(ray, slabs, rcp);
+    if constexpr (ByPrim) {
+        const PrimLeafRay p{isect, ray};
+        return trace_wide_subtree<N, M, TM, Test, AnyHit, true>(bvh, sphere_method, 0, nr, LeafRay<vfloat<M>>{}, tfar,
+                                                                hit, &p);
+    } else {
+        return trace_wide_subtree<N, M, TM, Test, AnyHit>(bvh, sphere_method, 0, nr, make_leaf_ray<vfloat<M>>(ray, TM),
+                                                          tfar, hit);
+    }
 }
 
 }  // namespace raypack
