@@ -52,12 +52,16 @@ public:
 private:
     template <bool AnyHit>
     void trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const;
-    template <bool AnyHit, bool Counting, bool Mailbox>
+    template <bool AnyHit, bool Counting, bool Mailbox, SlabMethod Slabs>
     bool trace(Rayf& ray, Hitf& hit, GridRayCounters* counters) const;
+    /// Picks the instance once per ray (predictable branches on fixed flags).
     template <bool AnyHit, bool Counting>
     bool trace(Rayf& ray, Hitf& hit, GridRayCounters* counters) const {
-        return mailbox_ ? trace<AnyHit, Counting, true>(ray, hit, counters)
-                        : trace<AnyHit, Counting, false>(ray, hit, counters);
+        if (kernels_.slabs == SlabMethod::Plain)
+            return mailbox_ ? trace<AnyHit, Counting, true, SlabMethod::Plain>(ray, hit, counters)
+                            : trace<AnyHit, Counting, false, SlabMethod::Plain>(ray, hit, counters);
+        return mailbox_ ? trace<AnyHit, Counting, true, SlabMethod::Robust>(ray, hit, counters)
+                        : trace<AnyHit, Counting, false, SlabMethod::Robust>(ray, hit, counters);
     }
 
     const Scene* scene_;

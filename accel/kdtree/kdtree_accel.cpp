@@ -53,17 +53,25 @@ double KdTreeAccel::references_per_primitive() const {
 // direction component +-0, reciprocal() clamps it) visits both children.
 // Any hit the kernels report is genuine and shrinks tfar; a node is skipped
 // once its interval starts past tfar.
-template <bool AnyHit, bool Counting>
+// Slabs = Plain (`--slabs plain`): root box and split planes are all slab
+// planes, so both take the plain form, p * rdir - org * rdir fused, without
+// the margin: pbrt's traversal, whose misses near planes the robust form's
+// margin exists to avoid.
+template <bool AnyHit, bool Counting, SlabMethod Slabs>
 bool KdTreeAccel::trace(Rayf& ray, Hitf& hit, KdRayCounters* counters) const {
     if constexpr (Counting) ++counters->rays;
     if (tree_.empty()) return false;
-    const Vec3f rdir = reciprocal(ray.dir);
+    const Vec3f rdir = reciprocal(ray.dir, kernels_.rcp);
     float tmin, tmax;
-    if (!kd_ray_interval<float>(true, ray.org, rdir, ray.tnear, ray.tfar, tree_.bounds, tree_.margin, tmin, tmax))
+    if (!kd_ray_interval<float, Slabs>(true, ray.org, rdir, ray.tnear, ray.tfar, tree_.bounds, tree_.margin, tmin,
+                                       tmax))
         return false;
-    const float slack[3] = {tree_.margin * std::fabs(rdir.x), tree_.margin * std::fabs(rdir.y),
-                            tree_.margin * std::fabs(rdir.z)};
+    constexpr bool plain = Slabs == SlabMethod::Plain;
+    const Vec3f org_rdir{ray.org.x * rdir.x, ray.org.y * rdir.y, ray.org.z * rdir.z};
+    const float margin = plain ? 0.0f : tree_.margin;
+    const float slack[3] = {margin * std::fabs(rdir.x), margin * std::fabs(rdir.y), margin * std::fabs(rdir.z)};
     const PrimitiveIntersector<float> isect{scene_, kernels_};
+    const bool double_ties = kernels_.precision == Precision::Double;
     const KdNode* nodes = tree_.nodes.data();
     struct PendingNode {
         std::uint32_t node;
@@ -78,8 +86,9 @@ bool KdTreeAccel::trace(Rayf& ray, Hitf& hit, KdRayCounters* counters) const {
         if constexpr (Counting) ++counters->nodes_visited;
         if (!node.is_leaf()) {
             const int a = node.axis();
-            const float t_split = (node.split() - ray.org[a]) * rdir[a];
-            const float near_end = t_split + slack[a], far_start = t_split - slack[a];
+            const float t_split = plane_distance<Slabs>(node.split(), ray.org[a], rdir[a], org_rdir[a]);
+            const float near_end = plain ? t_split : t_split + slack[a];
+            const float far_start = plain ? t_split : t_split - slack[a];
             const bool below_first = rdir[a] >= 0.0f;
             const std::uint32_t near = below_first ? current + 1 : node.above_child();
             const std::uint32_t far = below_first ? node.above_child() : current + 1;
@@ -105,6 +114,17 @@ bool KdTreeAccel::trace(Rayf& ray, Hitf& hit, KdRayCounters* counters) const {
         const std::uint32_t* prims = tree_.leaf_prims(nodes[current]);
         for (std::uint32_t k = 0; k < count; ++k) {
             const Hitf before = hit;
+            if constexpr (!AnyHit) {
+                if (double_ties && found) {  // see kd_tie_tfar()
+                    Rayf probe = ray;
+                    probe.tfar = kd_tie_tfar(ray.tfar);
+                    if (isect.intersect(prims[k], probe, hit)) {
+                        if (hit.t > before.t || (hit.t == before.t && before.prim < prims[k])) hit = before;
+                        ray.tfar = hit.t;
+                    }
+                    continue;
+                }
+            }
             if (isect.intersect(prims[k], ray, hit)) {
                 found = true;
                 if constexpr (AnyHit) return true;
