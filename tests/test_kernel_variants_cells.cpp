@@ -27,6 +27,7 @@
 #include "tests/oracle_harness.h"
 #include "accel/accel.h"
 #include "accel/brute/brute_force.h"
+#include "accel/cell_kernel_variants.h"
 #include "accel/grid/grid_accel.h"
 #include "accel/kdtree/kdtree_accel.h"
 #include "accel/octree/octree_accel.h"
@@ -411,6 +412,50 @@ TEST_P(KernelVariantsCells, RobustWatertightLosesNoAdversarialHit) {
 }
 
 INSTANTIATE_TEST_SUITE_P(, KernelVariantsCells, ::testing::ValuesIn(kScenes), param_name);
+
+// The hits above cannot tell an approximate rdir from an exact one (the
+// structures' margins absorb a few ulps), so the packets' rdir is checked
+// here: use_rcp() gives every lane the single ray's reciprocal(dir, rcp),
+// and approximate ones do differ from exact ones.
+template <int K>
+void check_use_rcp(std::mt19937& rng) {
+    std::vector<Rayf> rays(K);
+    int approx_differs = 0;
+    for (int round = 0; round < 200; ++round) {
+        for (int l = 0; l < K; ++l) {
+            rays[l].org = {0, 0, 0};
+            rays[l].dir = random_direction(rng);
+            if (l == 1) rays[l].dir.y = signed_zero(rng);
+        }
+        for (RcpMethod rcp : {RcpMethod::Exact, RcpMethod::Approx}) {
+            vmask<K> valid;
+            RayPacket<K> p = load_packet<K>(rays, valid);
+            use_rcp<K>(p, rcp);
+            alignas(64) float r[3][K];
+            for (int a = 0; a < 3; ++a) store_lanes(r[a], p.rdir[a]);
+            for (int l = 0; l < K; ++l) {
+                const Vec3f want = reciprocal(rays[l].dir, rcp);
+                for (int a = 0; a < 3; ++a) ASSERT_EQ(bits(r[a][l]), bits(want[a])) << K << " lane " << l;
+                if (rcp == RcpMethod::Approx)
+                    for (int a = 0; a < 3; ++a) approx_differs += want[a] != reciprocal(rays[l].dir)[a];
+            }
+        }
+    }
+    EXPECT_GT(approx_differs, 0) << "approximate reciprocals all equal the exact ones: --rcp approx is not approximate";
+}
+
+TEST(KernelVariantsCellsRcp, PacketsGetTheSingleRaysReciprocals) {
+    std::mt19937 rng(11);
+#if defined(__SSE4_2__)
+    check_use_rcp<4>(rng);
+#endif
+#if defined(__AVX2__)
+    check_use_rcp<8>(rng);
+#endif
+#if defined(__AVX512BW__)
+    check_use_rcp<16>(rng);
+#endif
+}
 
 }  // namespace
 }  // namespace raypack::kernel_variants_cells_test
