@@ -54,14 +54,16 @@ private:
     void trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const;
     template <bool AnyHit, bool Counting, bool Mailbox, SlabMethod Slabs>
     bool trace(Rayf& ray, Hitf& hit, GridRayCounters* counters) const;
-    /// Picks the instance once per ray (predictable branches on fixed flags).
+    template <bool AnyHit, bool Counting, SlabMethod Slabs>
+    bool trace_with(Rayf& ray, Hitf& hit, GridRayCounters* counters) const {
+        return mailbox_ ? trace<AnyHit, Counting, true, Slabs>(ray, hit, counters)
+                        : trace<AnyHit, Counting, false, Slabs>(ray, hit, counters);
+    }
+    /// The counting walk picks the slab form per ray (it is never timed).
     template <bool AnyHit, bool Counting>
     bool trace(Rayf& ray, Hitf& hit, GridRayCounters* counters) const {
-        if (kernels_.slabs == SlabMethod::Plain)
-            return mailbox_ ? trace<AnyHit, Counting, true, SlabMethod::Plain>(ray, hit, counters)
-                            : trace<AnyHit, Counting, false, SlabMethod::Plain>(ray, hit, counters);
-        return mailbox_ ? trace<AnyHit, Counting, true, SlabMethod::Robust>(ray, hit, counters)
-                        : trace<AnyHit, Counting, false, SlabMethod::Robust>(ray, hit, counters);
+        return kernels_.slabs == SlabMethod::Plain ? trace_with<AnyHit, Counting, SlabMethod::Plain>(ray, hit, counters)
+                                                   : trace_with<AnyHit, Counting, SlabMethod::Robust>(ray, hit, counters);
     }
 
     const Scene* scene_;

@@ -42,7 +42,7 @@ public:
 private:
     template <bool AnyHit, bool Counting, SlabMethod Slabs>
     bool trace(Rayf& ray, Hitf& hit, OctreeRayCounters* counters) const;
-    /// Picks the slab form's instance once per ray.
+    /// The counting walk picks the slab form per ray (it is never timed).
     template <bool AnyHit, bool Counting>
     bool trace(Rayf& ray, Hitf& hit, OctreeRayCounters* counters) const {
         return kernels_.slabs == SlabMethod::Plain ? trace<AnyHit, Counting, SlabMethod::Plain>(ray, hit, counters)
