@@ -261,8 +261,8 @@ std::unique_ptr<Accel> make(const Scene& scene, const std::string& kind, const K
 
 Scene load(const std::string& file) { return load_scene(std::string(RAYPACK_SOURCE_DIR) + "/scenes/" + file); }
 
-// The shared scenes but the two largest, gears and bunny, whose fifteen
-// builds per test alone would take some 30 s (test_grid.cpp, test_octree.cpp
+// The shared scenes but the two largest, gears and bunny, whose builds (up
+// to fifteen per test) alone would take some 30 s (test_grid.cpp, test_octree.cpp
 // and test_kdtree.cpp trace them with the default variant).
 const std::vector<std::string> kScenes = {"balls.nff", "mount.nff", "rings.nff", "teapot.nff", "tetra.nff",
                                           "tree.nff"};

@@ -54,6 +54,7 @@ private:
     void trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const;
     template <bool AnyHit, bool Counting, bool Mailbox, SlabMethod Slabs>
     bool trace(Rayf& ray, Hitf& hit, GridRayCounters* counters) const;
+    /// trace() with or without the mailbox, chosen per ray as before the variants.
     template <bool AnyHit, bool Counting, SlabMethod Slabs>
     bool trace_with(Rayf& ray, Hitf& hit, GridRayCounters* counters) const {
         return mailbox_ ? trace<AnyHit, Counting, true, Slabs>(ray, hit, counters)
