@@ -19,11 +19,17 @@
 // Where rounding makes the walk differ from the exact one, it does so within
 // a few ulps of t of a cell plane; the builder widens cells by a margin that
 // covers this (grid_build.h).
+//
+// `--slabs plain` (SlabTag<Plain>): the cell planes are slab planes too, so
+// their first crossings t_first use the plain form p * rdir - org * rdir
+// like the root clip (cell_kernel_variants.h); tDelta and the stepping rule
+// for parallel axes are the walk's own and stay as they are.
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <optional>
 
+#include "accel/cell_kernel_variants.h"
 #include "accel/grid/grid.h"
 
 namespace raypack {
@@ -38,9 +44,10 @@ class GridDda {
 public:
     /// Walk of the ray (org, dir) from parameter t_start, which should lie in
     /// the grid's box (the entry distance of the slab test). `inv_dir` is
-    /// reciprocal(dir), computed once by the caller for the slab test too.
+    /// reciprocal(dir, rcp), computed once by the caller for the slab test too.
+    template <SlabMethod S = SlabMethod::Robust>
     RAYPACK_INLINE GridDda(const GridGeometry& g, const Vec3f& org, const Vec3f& dir, const Vec3f& inv_dir,
-                           float t_start)
+                           float t_start, SlabTag<S> = {})
         : t_enter_(t_start) {
         const Vec3f p = org + dir * t_start;
         std::int32_t stride = 1;
@@ -62,7 +69,8 @@ public:
                 const bool up = dir[a] > 0;
                 left_[a] = up ? g.res[a] - 1 - i : i;
                 stride_[a] = up ? stride : -stride;
-                t_first_[a] = t_next_[a] = (g.plane(a, up ? i + 1 : i) - org[a]) * inv_dir[a];
+                t_first_[a] = t_next_[a] =
+                    plane_distance<S>(g.plane(a, up ? i + 1 : i), org[a], inv_dir[a], org[a] * inv_dir[a]);
                 t_delta_[a] = g.cell_size[a] * std::fabs(inv_dir[a]);
             }
             stride *= g.res[a];

@@ -6,16 +6,18 @@
 //
 // Per-axis counters are kept as floats (exact below 2^24 cells per axis,
 // which the caller checks); the linear cell index is a vector of int32.
+// S is the slab form of the cell planes' first crossings, as in dda.h.
 #include <cstdint>
 #include <limits>
 
+#include "accel/cell_kernel_variants.h"
 #include "accel/grid/grid.h"
 #include "kernels/ray_packet.h"
 #include "kernels/simd.h"
 
 namespace raypack {
 
-template <int K>
+template <int K, SlabMethod S = SlabMethod::Robust>
 class GridDdaPacket {
 public:
     using F = vfloat<K>;
@@ -51,7 +53,7 @@ public:
             const I s(stride);
             stride_[a] = select_int(up, s, -s) & ~int_mask(parallel);
             const F plane = lo + select(up, fi + one, fi) * cs;
-            t_first_[a] = t_next_[a] = select(parallel, inf, (plane - org) * rdir);
+            t_first_[a] = t_next_[a] = select(parallel, inf, plane_distance<S>(plane, org, rdir, org * rdir));
             t_delta_[a] = select(parallel, zero, cs * vabs(rdir));
             steps_[a] = zero;
             stride *= g.res[a];

@@ -52,12 +52,19 @@ public:
 private:
     template <bool AnyHit>
     void trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const;
-    template <bool AnyHit, bool Counting, bool Mailbox>
+    template <bool AnyHit, bool Counting, bool Mailbox, SlabMethod Slabs>
     bool trace(Rayf& ray, Hitf& hit, GridRayCounters* counters) const;
+    /// trace() with or without the mailbox, chosen per ray as before the variants.
+    template <bool AnyHit, bool Counting, SlabMethod Slabs>
+    bool trace_with(Rayf& ray, Hitf& hit, GridRayCounters* counters) const {
+        return mailbox_ ? trace<AnyHit, Counting, true, Slabs>(ray, hit, counters)
+                        : trace<AnyHit, Counting, false, Slabs>(ray, hit, counters);
+    }
+    /// The counting walk picks the slab form per ray (it is never timed).
     template <bool AnyHit, bool Counting>
     bool trace(Rayf& ray, Hitf& hit, GridRayCounters* counters) const {
-        return mailbox_ ? trace<AnyHit, Counting, true>(ray, hit, counters)
-                        : trace<AnyHit, Counting, false>(ray, hit, counters);
+        return kernels_.slabs == SlabMethod::Plain ? trace_with<AnyHit, Counting, SlabMethod::Plain>(ray, hit, counters)
+                                                   : trace_with<AnyHit, Counting, SlabMethod::Robust>(ray, hit, counters);
     }
 
     const Scene* scene_;

@@ -3,6 +3,7 @@
 #include <bit>
 #include <limits>
 
+#include "accel/cell_kernel_variants.h"
 #include "accel/grid/dda_packet.h"
 #include "accel/packet_driver.h"
 #include "accel/packet_intersector.h"
@@ -37,17 +38,17 @@ RAYPACK_INLINE vmask<K> mask_from_bits(std::uint32_t bits) {
 // stands in it, and those lanes step too. A lane stops where its single-ray
 // walk stops: when its current cell ends past its tfar, or at the grid's
 // boundary (or, for occlusion, at its first hit).
-template <int K, bool AnyHit>
+template <int K, bool AnyHit, SlabMethod Slabs>
 void trace_packet(const Grid& grid, const PacketPrimitiveIntersector<vfloat<K>>& isect, RayPacket<K>& ray,
                   HitPacket<K>& hit, vmask<K> valid, vmask<K>& occluded) {
     using F = vfloat<K>;
     using M = vmask<K>;
     const GridGeometry& g = grid.geometry;
-    const SlabRay<F> slab{ray.org, ray.rdir, {}, ray.tnear, ray.tfar};  // robust: org_rdir unused
+    const SlabRay<F> slab = make_slab_ray(ray.org, ray.rdir, ray.tnear, ray.tfar);
     F entry;
-    M active = intersect_box<SlabMethod::Robust, F>(valid, slab, splat<F>(g.bounds.lo), splat<F>(g.bounds.hi), entry);
+    M active = intersect_box<Slabs, F>(valid, slab, splat<F>(g.bounds.lo), splat<F>(g.bounds.hi), entry);
     if (none(active)) return;
-    GridDdaPacket<K> dda(g, ray, entry);
+    GridDdaPacket<K, Slabs> dda(g, ray, entry);
     const std::uint32_t* begin = grid.cell_begin.data();
     const std::uint32_t* refs = grid.refs.data();
     alignas(64) std::int32_t cell[K];
@@ -78,7 +79,7 @@ void trace_packet(const Grid& grid, const PacketPrimitiveIntersector<vfloat<K>>&
             }
         }
         const M step = active & mask_from_bits<K>(walking);
-        const typename GridDdaPacket<K>::Crossing x = dda.crossing();
+        const typename GridDdaPacket<K, Slabs>::Crossing x = dda.crossing();
         const M beyond = step & (x.t > ray.tfar);
         active = active & !beyond;
         active = active & !dda.advance(x, step & !beyond);
@@ -99,10 +100,17 @@ void grid_trace_packets(const Grid& grid, const Scene& scene, KernelChoice kerne
                         std::span<Hitf> hits) {
     using F = vfloat<K>;
     const PacketPrimitiveIntersector<F> isect{&scene, kernels};
-    trace_in_packets<K, AnyHit>(rays, hits, [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid,
-                                                vmask<K>& occluded) {
-        if (!grid.empty()) trace_packet<K, AnyHit>(grid, isect, ray, hit, valid, occluded);
-    });
+    // The slab form is chosen once for all packets, rdir once per packet.
+    auto run = [&]<SlabMethod Slabs>(SlabTag<Slabs>) {
+        trace_in_packets<K, AnyHit>(rays, hits, [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid,
+                                                    vmask<K>& occluded) {
+            if (grid.empty()) return;
+            use_rcp<K>(ray, kernels.rcp);
+            trace_packet<K, AnyHit, Slabs>(grid, isect, ray, hit, valid, occluded);
+        });
+    };
+    if (kernels.slabs == SlabMethod::Plain) run(SlabTag<SlabMethod::Plain>{});
+    else run(SlabTag<SlabMethod::Robust>{});
 }
 
 #if defined(__SSE4_2__)

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "accel/cell_kernel_variants.h"
 #include "accel/count_each_ray.h"
 #include "accel/kdtree/kdtree_build.h"
 #include "accel/kdtree/kdtree_packet.h"
@@ -44,6 +45,23 @@ double KdTreeAccel::references_per_primitive() const {
     return n ? double(tree_.references) / double(n) : 0.0;
 }
 
+namespace {
+
+/// A closest-hit test under --precision double once the ray has a hit:
+/// against tfar widened by kd_tie_tfar(), keeping the nearer hit and on equal
+/// t the lower primitive. Out of line, off the default path.
+[[gnu::noinline]] void test_after_hit_in_double(const PrimitiveIntersector<float>& isect, std::uint32_t prim,
+                                                Rayf& ray, Hitf& hit) {
+    const Hitf before = hit;
+    Rayf probe = ray;
+    probe.tfar = kd_tie_tfar(ray.tfar);
+    if (!isect.intersect(prim, probe, hit)) return;
+    if (hit.t > before.t || (hit.t == before.t && before.prim < prim)) hit = before;
+    ray.tfar = hit.t;
+}
+
+}  // namespace
+
 // Front-to-back traversal with a stack of far children and their intervals
 // (Havran's TA_B; pbrt's KdTreeAggregate::Intersect). Each split plane is
 // widened by the tree's margin: the below child is visited where the ray is
@@ -53,17 +71,25 @@ double KdTreeAccel::references_per_primitive() const {
 // direction component +-0, reciprocal() clamps it) visits both children.
 // Any hit the kernels report is genuine and shrinks tfar; a node is skipped
 // once its interval starts past tfar.
-template <bool AnyHit, bool Counting>
+// Slabs = Plain (`--slabs plain`): root box and split planes are all slab
+// planes, so both take the plain form, p * rdir - org * rdir fused, without
+// the margin: pbrt's traversal, whose misses near planes the robust form's
+// margin exists to avoid.
+template <bool AnyHit, bool Counting, SlabMethod Slabs>
 bool KdTreeAccel::trace(Rayf& ray, Hitf& hit, KdRayCounters* counters) const {
     if constexpr (Counting) ++counters->rays;
     if (tree_.empty()) return false;
-    const Vec3f rdir = reciprocal(ray.dir);
+    const Vec3f rdir = ray_reciprocal(ray.dir, kernels_.rcp);
     float tmin, tmax;
-    if (!kd_ray_interval<float>(true, ray.org, rdir, ray.tnear, ray.tfar, tree_.bounds, tree_.margin, tmin, tmax))
+    if (!kd_ray_interval<float, Slabs>(true, ray.org, rdir, ray.tnear, ray.tfar, tree_.bounds, tree_.margin, tmin,
+                                       tmax))
         return false;
-    const float slack[3] = {tree_.margin * std::fabs(rdir.x), tree_.margin * std::fabs(rdir.y),
-                            tree_.margin * std::fabs(rdir.z)};
+    constexpr bool plain = Slabs == SlabMethod::Plain;
+    const Vec3f org_rdir{ray.org.x * rdir.x, ray.org.y * rdir.y, ray.org.z * rdir.z};
+    const float margin = plain ? 0.0f : tree_.margin;
+    const float slack[3] = {margin * std::fabs(rdir.x), margin * std::fabs(rdir.y), margin * std::fabs(rdir.z)};
     const PrimitiveIntersector<float> isect{scene_, kernels_};
+    const bool double_ties = kernels_.precision == Precision::Double;
     const KdNode* nodes = tree_.nodes.data();
     struct PendingNode {
         std::uint32_t node;
@@ -78,8 +104,9 @@ bool KdTreeAccel::trace(Rayf& ray, Hitf& hit, KdRayCounters* counters) const {
         if constexpr (Counting) ++counters->nodes_visited;
         if (!node.is_leaf()) {
             const int a = node.axis();
-            const float t_split = (node.split() - ray.org[a]) * rdir[a];
-            const float near_end = t_split + slack[a], far_start = t_split - slack[a];
+            const float t_split = plane_distance<Slabs>(node.split(), ray.org[a], rdir[a], org_rdir[a]);
+            const float near_end = plain ? t_split : t_split + slack[a];
+            const float far_start = plain ? t_split : t_split - slack[a];
             const bool below_first = rdir[a] >= 0.0f;
             const std::uint32_t near = below_first ? current + 1 : node.above_child();
             const std::uint32_t far = below_first ? node.above_child() : current + 1;
@@ -105,6 +132,12 @@ bool KdTreeAccel::trace(Rayf& ray, Hitf& hit, KdRayCounters* counters) const {
         const std::uint32_t* prims = tree_.leaf_prims(nodes[current]);
         for (std::uint32_t k = 0; k < count; ++k) {
             const Hitf before = hit;
+            if constexpr (!AnyHit) {
+                if (double_ties && found) [[unlikely]] {
+                    test_after_hit_in_double(isect, prims[k], ray, hit);
+                    continue;
+                }
+            }
             if (isect.intersect(prims[k], ray, hit)) {
                 found = true;
                 if constexpr (AnyHit) return true;
@@ -129,21 +162,31 @@ bool KdTreeAccel::trace(Rayf& ray, Hitf& hit, KdRayCounters* counters) const {
     }
 }
 
+// The slab form is chosen once per batch, so that each loop inlines one
+// instance of the walk (choosing it per ray cost the octree 25%).
 void KdTreeAccel::intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const {
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-        Rayf ray = rays[i];
-        Hitf hit;
-        trace<false, false>(ray, hit, nullptr);
-        hits[i] = hit;
-    }
+    auto run = [&]<SlabMethod Slabs>(SlabTag<Slabs>) {
+        for (std::size_t i = 0; i < rays.size(); ++i) {
+            Rayf ray = rays[i];
+            Hitf hit;
+            trace<false, false, Slabs>(ray, hit, nullptr);
+            hits[i] = hit;
+        }
+    };
+    if (kernels_.slabs == SlabMethod::Plain) run(SlabTag<SlabMethod::Plain>{});
+    else run(SlabTag<SlabMethod::Robust>{});
 }
 
 void KdTreeAccel::occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const {
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-        Rayf ray = rays[i];
-        Hitf hit;
-        occluded[i] = trace<true, false>(ray, hit, nullptr) ? 1 : 0;
-    }
+    auto run = [&]<SlabMethod Slabs>(SlabTag<Slabs>) {
+        for (std::size_t i = 0; i < rays.size(); ++i) {
+            Rayf ray = rays[i];
+            Hitf hit;
+            occluded[i] = trace<true, false, Slabs>(ray, hit, nullptr) ? 1 : 0;
+        }
+    };
+    if (kernels_.slabs == SlabMethod::Plain) run(SlabTag<SlabMethod::Plain>{});
+    else run(SlabTag<SlabMethod::Robust>{});
 }
 
 Hitf KdTreeAccel::intersect_counting(const Rayf& ray_in, KdRayCounters& counters) const {

@@ -31,26 +31,41 @@ void keep_lowest_on_ties(const vmask<K>& tie, const HitPacket<K>& before, HitPac
     hit.v = load_lanes<vfloat<K>>(v);
 }
 
+/// The lanes of `m` get back their hit from `before`.
+template <int K>
+void restore_lanes(const vmask<K>& m, const HitPacket<K>& before, HitPacket<K>& hit) {
+    hit.t = select(m, before.t, hit.t);
+    hit.u = select(m, before.u, hit.u);
+    hit.v = select(m, before.v, hit.v);
+    for (std::uint32_t bits = mask_bits(m); bits; bits &= bits - 1) {
+        const int l = std::countr_zero(bits);
+        hit.prim[l] = before.prim[l];
+    }
+}
+
 // The single-ray traversal of kdtree_accel.cpp lane by lane: the same
 // widened planes, so every lane visits at least the leaves its single ray
 // would, and the same kernels, so the hits are bit for bit the same. A lane
 // is active in a node while tmin <= min(tmax, tfar).
-template <int K, bool AnyHit>
+template <int K, bool AnyHit, SlabMethod Slabs>
 void trace_packet(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>>& isect, RayPacket<K>& ray,
                   HitPacket<K>& hit, vmask<K> valid, vmask<K>& occluded) {
     using F = vfloat<K>;
     using M = vmask<K>;
     const F inf(std::numeric_limits<float>::infinity());
     F tmin, tmax;
-    const M in_box =
-        kd_ray_interval<F>(valid, ray.org, ray.rdir, ray.tnear, ray.tfar, tree.bounds, tree.margin, tmin, tmax);
+    const M in_box = kd_ray_interval<F, Slabs>(valid, ray.org, ray.rdir, ray.tnear, ray.tfar, tree.bounds,
+                                               tree.margin, tmin, tmax);
     if (none(in_box)) return;
     // Inactive lanes get an empty interval, which stays empty in every child.
     tmin = select(in_box, tmin, inf);
     tmax = select(in_box, tmax, -inf);
-    const F margin(tree.margin);
+    constexpr bool plain = Slabs == SlabMethod::Plain;
+    const F margin(plain ? 0.0f : tree.margin);
     const Vec3<F> slack{margin * vabs(ray.rdir.x), margin * vabs(ray.rdir.y), margin * vabs(ray.rdir.z)};
+    const Vec3<F> org_rdir{ray.org.x * ray.rdir.x, ray.org.y * ray.rdir.y, ray.org.z * ray.rdir.z};
     const M positive[3] = {ray.rdir.x >= F(0.0f), ray.rdir.y >= F(0.0f), ray.rdir.z >= F(0.0f)};
+    const bool double_ties = isect.kernels.precision == Precision::Double;
     const KdNode* nodes = tree.nodes.data();
     struct PendingNode {
         F tmin, tmax;
@@ -63,8 +78,9 @@ void trace_packet(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>
         const KdNode node = nodes[current];
         if (!node.is_leaf()) {
             const int a = node.axis();
-            const F t_split = (F(node.split()) - ray.org[a]) * ray.rdir[a];
-            const F near_end = vmin(tmax, t_split + slack[a]), far_start = vmax(tmin, t_split - slack[a]);
+            const F t_split = plane_distance<Slabs>(F(node.split()), ray.org[a], ray.rdir[a], org_rdir[a]);
+            const F near_end = vmin(tmax, plain ? t_split : t_split + slack[a]);
+            const F far_start = vmax(tmin, plain ? t_split : t_split - slack[a]);
             // Per lane, below is the near side where the direction is positive.
             const M pos = positive[a];
             const F below_lo = select(pos, tmin, far_start), below_hi = select(pos, near_end, tmax);
@@ -97,6 +113,15 @@ void trace_packet(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>
                 occluded = occluded | m;
                 active = active & !m;
                 if (none(active)) break;
+            } else if (double_ties) {  // see kd_tie_tfar()
+                const HitPacket<K> before = hit;
+                const F tfar = ray.tfar;
+                ray.tfar = select(active & (before.t < inf), kd_tie_tfar(tfar), tfar);
+                const M m = isect.intersect(active, ray, hit, prims[k]);
+                const M farther = m & (hit.t > before.t);
+                if (any(farther)) restore_lanes<K>(farther, before, hit);
+                ray.tfar = select(m & !farther, hit.t, tfar);
+                if (any(m)) keep_lowest_on_ties<K>(m & !farther & (hit.t == before.t), before, hit, prims[k]);
             } else {
                 const HitPacket<K> before = hit;
                 const M m = isect.intersect(active, ray, hit, prims[k]);
@@ -131,10 +156,17 @@ void kdtree_trace_packets(const KdTree& tree, const Scene& scene, KernelChoice k
                           std::span<Hitf> hits) {
     using F = vfloat<K>;
     const PacketPrimitiveIntersector<F> isect{&scene, kernels};
-    trace_in_packets<K, AnyHit>(rays, hits, [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid,
-                                                vmask<K>& occluded) {
-        if (!tree.empty()) trace_packet<K, AnyHit>(tree, isect, ray, hit, valid, occluded);
-    });
+    // The slab form is chosen once for all packets, rdir once per packet.
+    auto run = [&]<SlabMethod Slabs>(SlabTag<Slabs>) {
+        trace_in_packets<K, AnyHit>(rays, hits, [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid,
+                                                    vmask<K>& occluded) {
+            if (tree.empty()) return;
+            use_rcp<K>(ray, kernels.rcp);
+            trace_packet<K, AnyHit, Slabs>(tree, isect, ray, hit, valid, occluded);
+        });
+    };
+    if (kernels.slabs == SlabMethod::Plain) run(SlabTag<SlabMethod::Plain>{});
+    else run(SlabTag<SlabMethod::Robust>{});
 }
 
 #if defined(__SSE4_2__)

@@ -40,8 +40,14 @@ public:
     std::size_t empty_leaves() const { return empty_leaves_; }
 
 private:
-    template <bool AnyHit, bool Counting>
+    template <bool AnyHit, bool Counting, SlabMethod Slabs>
     bool trace(Rayf& ray, Hitf& hit, OctreeRayCounters* counters) const;
+    /// The counting walk picks the slab form per ray (it is never timed).
+    template <bool AnyHit, bool Counting>
+    bool trace(Rayf& ray, Hitf& hit, OctreeRayCounters* counters) const {
+        return kernels_.slabs == SlabMethod::Plain ? trace<AnyHit, Counting, SlabMethod::Plain>(ray, hit, counters)
+                                                   : trace<AnyHit, Counting, SlabMethod::Robust>(ray, hit, counters);
+    }
     template <bool AnyHit>
     void trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const;
 

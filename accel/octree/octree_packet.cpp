@@ -3,6 +3,7 @@
 #include <bit>
 #include <limits>
 
+#include "accel/cell_kernel_variants.h"
 #include "accel/packet_driver.h"
 #include "accel/packet_intersector.h"
 #include "kernels/aabb.h"
@@ -34,7 +35,7 @@ struct PacketFrame {
 // [tnear, tfar], which is the set of children each lane's own walk of
 // Revelles et al. visits; tfar shrinks with each hit, so a lane drops out of
 // every node behind its closest hit (early termination per lane).
-template <int K, bool AnyHit>
+template <int K, bool AnyHit, SlabMethod Slabs>
 void walk(const Octree& tree, const PacketPrimitiveIntersector<vfloat<K>>& isect, RayPacket<K>& ray,
           HitPacket<K>& hit, vmask<K> group, unsigned a, vmask<K>& occluded) {
     using F = vfloat<K>;
@@ -48,7 +49,9 @@ void walk(const Octree& tree, const PacketPrimitiveIntersector<vfloat<K>>& isect
     PacketFrame<K>* f = &stack[0];
     const Vec3<F> lo = splat<F>(tree.cube.lo), hi = splat<F>(tree.cube.hi);
     for (int k = 0; k < 3; ++k) {
-        const F tlo = (lo[k] - ray.org[k]) * ray.rdir[k], thi = (hi[k] - ray.org[k]) * ray.rdir[k];
+        const F od = ray.org[k] * ray.rdir[k];
+        const F tlo = plane_distance<Slabs>(lo[k], ray.org[k], ray.rdir[k], od),
+                thi = plane_distance<Slabs>(hi[k], ray.org[k], ray.rdir[k], od);
         const bool mirrored = a & (4u >> k);
         f->t0[k] = mirrored ? thi : tlo;
         f->t1[k] = mirrored ? tlo : thi;
@@ -115,7 +118,7 @@ void walk(const Octree& tree, const PacketPrimitiveIntersector<vfloat<K>>& isect
     }
 }
 
-template <int K, bool AnyHit>
+template <int K, bool AnyHit, SlabMethod Slabs>
 void trace_packet(const Octree& tree, const PacketPrimitiveIntersector<vfloat<K>>& isect, RayPacket<K>& ray,
                   HitPacket<K>& hit, vmask<K> valid, vmask<K>& occluded) {
     using F = vfloat<K>;
@@ -133,7 +136,7 @@ void trace_packet(const Octree& tree, const PacketPrimitiveIntersector<vfloat<K>
             a |= n ? 4u >> k : 0u;
             group = group & (n ? neg[k] : !neg[k]);
         }
-        walk<K, AnyHit>(tree, isect, ray, hit, group, a, occluded);
+        walk<K, AnyHit, Slabs>(tree, isect, ray, hit, group, a, occluded);
         left = left & !group;
     }
 }
@@ -149,10 +152,16 @@ void octree_trace_packets(const Octree& tree, const Scene& scene, KernelChoice k
         return;
     }
     const PacketPrimitiveIntersector<F> isect{&scene, kernels};
-    trace_in_packets<K, AnyHit>(rays, hits, [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid,
-                                                vmask<K>& occluded) {
-        trace_packet<K, AnyHit>(tree, isect, ray, hit, valid, occluded);
-    });
+    // The slab form is chosen once for all packets, rdir once per packet.
+    auto run = [&]<SlabMethod Slabs>(SlabTag<Slabs>) {
+        trace_in_packets<K, AnyHit>(rays, hits, [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid,
+                                                    vmask<K>& occluded) {
+            use_rcp<K>(ray, kernels.rcp);
+            trace_packet<K, AnyHit, Slabs>(tree, isect, ray, hit, valid, occluded);
+        });
+    };
+    if (kernels.slabs == SlabMethod::Plain) run(SlabTag<SlabMethod::Plain>{});
+    else run(SlabTag<SlabMethod::Robust>{});
 }
 
 #if defined(__SSE4_2__)

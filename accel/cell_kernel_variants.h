@@ -1,0 +1,59 @@
+#pragma once
+// The traversal variants `--slabs` and `--rcp` (KernelChoice) as the cell
+// structures (grid, octree, k-d tree) use them: one plane distance in both
+// slab forms, and the approximate reciprocal for packets.
+#include <type_traits>
+
+#include "kernels/aabb.h"
+#include "kernels/ray_packet.h"
+#include "kernels/simd.h"
+
+namespace raypack {
+
+/// Selects a traversal's slab form at compile time; constructors take it as
+/// an argument, since their template arguments cannot be named.
+template <SlabMethod S>
+using SlabTag = std::integral_constant<SlabMethod, S>;
+
+/// Parameter at which the ray crosses the plane x_axis = p.
+/// Robust: (p - org) * rdir, as the robust slab test (Ize, JCGT 2013):
+/// exactly 0 for an origin on the plane, whatever rdir.
+/// Plain: one fused p * rdir - org * rdir with org * rdir computed once per
+/// ray (Embree's form, intersect_box<Plain>): one operation fewer, but an
+/// origin on the plane gives the rounding error of org * rdir, which a
+/// clamped rdir (+-1e18, a direction component of +-0) makes large.
+template <SlabMethod S, class F>
+RAYPACK_INLINE F plane_distance(const F& p, const F& org, const F& rdir, const F& org_rdir) {
+    if constexpr (S == SlabMethod::Plain) return vfmsub(p, rdir, org_rdir);
+    else return (p - org) * rdir;
+}
+
+/// reciprocal(dir, RcpMethod::Approx), out of line (see ray_reciprocal).
+[[gnu::noinline]] inline Vec3f approx_ray_reciprocal(const Vec3f& dir) { return reciprocal(dir, RcpMethod::Approx); }
+
+/// reciprocal(dir, rcp) for the single-ray walks. The approximate path stays
+/// out of line: inlined, its branches made gcc 12 compile the octree walk
+/// around it 25% slower even with exact reciprocals.
+RAYPACK_INLINE Vec3f ray_reciprocal(const Vec3f& dir, RcpMethod rcp) {
+    if (rcp == RcpMethod::Exact) [[likely]]
+        return reciprocal(dir);
+    return approx_ray_reciprocal(dir);
+}
+
+/// Overwrites the packet's rdir (load_packet computes it exactly) with
+/// reciprocal(dir, rcp), lane by lane at width 1 as the single-ray walks
+/// compute it, so that packets and single rays keep the same bits.
+template <int K>
+void use_rcp(RayPacket<K>& p, RcpMethod rcp) {
+    if (rcp == RcpMethod::Exact) return;
+    using F = vfloat<K>;
+    alignas(64) float d[3][K], r[3][K];
+    for (int a = 0; a < 3; ++a) store_lanes(d[a], p.dir[a]);
+    for (int l = 0; l < K; ++l) {
+        const Vec3f rd = reciprocal(Vec3f{d[0][l], d[1][l], d[2][l]}, rcp);
+        r[0][l] = rd.x, r[1][l] = rd.y, r[2][l] = rd.z;
+    }
+    p.rdir = {load_lanes<F>(r[0]), load_lanes<F>(r[1]), load_lanes<F>(r[2])};
+}
+
+}  // namespace raypack
