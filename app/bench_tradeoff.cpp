@@ -4,9 +4,12 @@
 
 #include <algorithm>
 #include <chrono>
-#include <functional>
 #include <cstdio>
+#include <functional>
+#include <map>
+#include <optional>
 
+#include "accel/bvh/bvh_builders.h"
 #include "app/accel_options.h"
 #include "app/bench_measure.h"
 #include "app/bench_tradeoff_report.h"
@@ -19,7 +22,7 @@ namespace raypack::app {
 namespace {
 
 /// Input sizes: the full run meets the figures (>= 10 million leak
-/// rays per triangle variant); --quick covers every family in seconds.
+/// rays per row at closed meshes); --quick covers every family in seconds.
 struct TradeoffSizes {
     std::uint64_t leak_rays, ulp_rays;
     int mesh_detail, tetra_size;
@@ -31,9 +34,10 @@ TradeoffSizes sizes_for(bool quick) {
     return {10'000'000, 2'000'000, 1, 4, 512, 384, 192};
 }
 
-// The standard scenes: throughput and image error of triangle variants on
-// the SPD teapot (triangles only, a reflective floor), of sphere and offset
-// variants on SPD balls (spheres on a polygon floor, mirror-like balls).
+// The standard scenes: throughput and image error of triangle, slab, rcp,
+// precision and builder variants on the SPD teapot (triangles only, a
+// reflective floor), of sphere and offset variants on SPD balls (spheres on
+// a polygon floor, mirror-like balls).
 constexpr const char* kTriangleScene = "gen:teapot:6";
 constexpr const char* kSphereTimingScene = "gen:balls:3";
 constexpr const char* kSphereImageScene = "gen:balls:2";
@@ -123,52 +127,125 @@ WhittedOptions image_options(int res, OffsetPolicy offset) {
     return o;
 }
 
-/// A family of primitive tests: its variants, where each is timed and
-/// rendered, and how its leaks are counted.
+/// One row of a kernel family: the structure, its builder and kernels.
+struct TradeVariant {
+    const char* name;
+    AccelConfig config;
+};
+
+TradeVariant variant(const char* name, const char* structure, KernelChoice kernels, const char* builder = "binned") {
+    AccelConfig config = accel_config(structure, kernels);
+    config.builder = builder;
+    return {name, config};
+}
+
+/// The double reference renders, each made once: they take longer than
+/// everything else they are compared with, and several families share one.
+class ReferenceImages {
+public:
+    const Image& get(const char* scene_name, const Scene& scene, const WhittedOptions& options, const Stages& stages) {
+        const std::string key = std::string(scene_name) + " " + offset_policy_name(options.offset);
+        auto it = images_.find(key);
+        if (it == images_.end()) {
+            stages.note("double reference render of " + key);
+            it = images_.emplace(key, render_double_reference(scene, options)).first;
+        }
+        return it->second;
+    }
+
+private:
+    std::map<std::string, Image> images_;
+};
+
+/// The error measures of one configuration, kept so that a configuration
+/// that recurs in another family (precision float is triangle moeller, rcp
+/// exact and builder binned are slabs robust) is measured once: every
+/// measure is deterministic, so a second run would only repeat the figures.
+struct Measured {
+    LeakCounts leaks;
+    std::optional<UlpError> t_ulps;
+    ImageError image;
+};
+
+/// A family of kernel or structure variants: its variants, where each is
+/// timed and rendered, and how its leaks are counted.
 struct KernelFamily {
     const char* name;
     PrimKind kind;
     const char* timing_scene;
     const char* image_scene;
-    std::vector<std::pair<const char*, KernelChoice>> variants;
-    ObjectScene leak_scene;
+    std::vector<TradeVariant> variants;
+    const ObjectScene* leak_scene;
     LeakCounts (*count_leaks)(const ObjectScene&, const Accel&, std::uint64_t, std::uint64_t);
+    /// False where the variants cannot change t (slab tests, reciprocals,
+    /// builders only decide which primitives get tested): the column would
+    /// repeat the primitive test's figure, which its own family reports.
+    bool measure_t = true;
+    /// Time the builds of the timing scene and report the SAH cost.
+    bool builds = false;
 };
 
+using MeasuredCache = std::map<std::string, Measured>;
+
 void run_kernel_family(const KernelFamily& family, const TradeoffPlan& plan, const TradeoffSizes& sizes,
-                       const Stages& stages, std::vector<TradeoffRow>& rows) {
+                       const Stages& stages, ReferenceImages& references, MeasuredCache& measured,
+                       std::vector<TradeoffRow>& rows) {
     const std::string name = family.name;
     const Scene timing_scene = load_scene(family.timing_scene), image_scene = load_scene(family.image_scene);
     const BenchRays camera = make_bench_rays(timing_scene, "camera", sizes.timing_res, sizes.timing_res);
-    const std::vector<ObjectScene> ulp = ulp_scenes();
+    const std::vector<ObjectScene> ulp = family.measure_t ? ulp_scenes() : std::vector<ObjectScene>{};
     const WhittedOptions options = image_options(sizes.image_res, kDefaultOffset);
-    stages.note(name + ": double reference render of " + family.image_scene);
-    const Image reference = render_double_reference(image_scene, options);
+    const Image& reference = references.get(family.image_scene, image_scene, options, stages);
     std::vector<std::unique_ptr<Accel>> accels;
-    std::vector<std::function<double()>> passes;
-    for (const auto& [variant, kernels] : family.variants) {
-        accels.push_back(build_accel(timing_scene, accel_config("bvh2", kernels)));
+    std::vector<std::function<double()>> passes, builds;
+    for (const TradeVariant& v : family.variants) {
+        accels.push_back(build_accel(timing_scene, v.config));
         passes.push_back([&camera, &accel = *accels.back()] { return time_one_pass(accel, camera); });
+        builds.push_back([&timing_scene, &config = v.config] { return build_accel(timing_scene, config)->stats().build_ms; });
     }
     stages.note(name + ": timing the variants in turns");
     const auto ms = interleaved_passes(passes, plan.repeat);
-    for (std::size_t v = 0; v < family.variants.size(); ++v) {
-        const auto& [variant, kernels] = family.variants[v];
-        stages.note(name + " " + variant);
-        AccelConfig config;
-        config.kind = "bvh2", config.kernels = kernels;
+    std::vector<std::vector<double>> build_ms;
+    if (family.builds) {
+        stages.note(name + ": timing the builds in turns");
+        build_ms = interleaved_passes(builds, plan.repeat);
+    }
+    for (std::size_t i = 0; i < family.variants.size(); ++i) {
+        const TradeVariant& v = family.variants[i];
         TradeoffRow row;
-        row.family = name, row.variant = variant, row.throughput_scene = family.timing_scene;
+        row.family = name, row.variant = v.name, row.throughput_scene = family.timing_scene;
         row.throughput_rays = "camera";
-        set_throughput(row, camera.rays.size(), ms[v]);
-        row.leaks = family.count_leaks(family.leak_scene, *build_accel(family.leak_scene.scene, config),
-                                       sizes.leak_rays, 1);
-        row.t_ulps = pooled_ulps(ulp, family.kind, kernels, sizes.ulp_rays);
-        Image image;
-        render_whitted(image_scene, *build_accel(image_scene, config), options, image);
-        row.image = image_error(image, reference);
+        set_throughput(row, camera.rays.size(), ms[i]);
+        // Everything the measures depend on besides the fixed sizes and seeds.
+        char leak_scene[32];
+        std::snprintf(leak_scene, sizeof leak_scene, "%p", static_cast<const void*>(family.leak_scene));
+        const std::string key = v.config.kind + " " + v.config.builder + " " + kernel_choice_summary(v.config.kernels) +
+                                " " + family.image_scene + " " + leak_scene + (family.measure_t ? " t" : "");
+        auto known = measured.find(key);
+        if (known == measured.end()) {
+            stages.note(name + " " + v.name + " (" + v.config.kind + ")");
+            Measured m;
+            m.leaks = family.count_leaks(*family.leak_scene, *build_accel(family.leak_scene->scene, v.config),
+                                         sizes.leak_rays, 1);
+            if (family.measure_t) m.t_ulps = pooled_ulps(ulp, family.kind, v.config.kernels, sizes.ulp_rays);
+            Image image;
+            render_whitted(image_scene, *build_accel(image_scene, v.config), options, image);
+            m.image = image_error(image, reference);
+            known = measured.emplace(key, m).first;
+        } else {
+            stages.note(name + " " + v.name + " (" + v.config.kind + "): errors as measured above, same configuration");
+        }
+        row.leaks = known->second.leaks;
+        row.t_ulps = known->second.t_ulps;
+        row.image = known->second.image;
         row.image_scene = family.image_scene;
         row.image_width = row.image_height = sizes.image_res;
+        row.structure = v.config.kind, row.builder = v.config.builder;
+        row.kernels = kernel_choice_summary(v.config.kernels);
+        if (family.builds) {
+            row.build_ms = median(build_ms[i]);
+            row.sah_cost = accels[i]->stats().sah_cost;
+        }
         rows.push_back(std::move(row));
     }
 }
@@ -198,7 +275,7 @@ double time_shadow_pass(const Scene& scene, const Accel& accel, const RayOffset&
 }
 
 void run_offset_family(const TradeoffPlan& plan, const TradeoffSizes& sizes, const Stages& stages,
-                       std::vector<TradeoffRow>& rows) {
+                       ReferenceImages& references, std::vector<TradeoffRow>& rows) {
     const Scene timing_scene = load_scene(kSphereTimingScene), image_scene = load_scene(kSphereImageScene);
     const auto timing_accel = build_accel(timing_scene, AccelConfig{});
     // The camera hits, once: the offset is timed from there.
@@ -219,8 +296,8 @@ void run_offset_family(const TradeoffPlan& plan, const TradeoffSizes& sizes, con
         placed.push_back(mixed_convex_scene(p.scale, Vec3f{p.translation, p.translation, p.translation}));
         placed_accels.push_back(build_accel(placed.back().scene, AccelConfig{}));
     }
-    stages.note("offset: double reference render of " + std::string(kSphereImageScene) + " (robust offset)");
-    const Image reference = render_double_reference(image_scene, image_options(sizes.image_res, OffsetPolicy::Robust));
+    const Image& reference =
+        references.get(kSphereImageScene, image_scene, image_options(sizes.image_res, OffsetPolicy::Robust), stages);
     const OffsetPolicy policies[] = {OffsetPolicy::Epsilon, OffsetPolicy::Scaled, OffsetPolicy::Robust};
     std::vector<Rayf> shadow(camera.size());
     std::vector<std::uint8_t> occluded(camera.size());
@@ -248,6 +325,8 @@ void run_offset_family(const TradeoffPlan& plan, const TradeoffSizes& sizes, con
         row.image = image_error(image, reference);
         row.image_scene = kSphereImageScene;
         row.image_width = row.image_height = sizes.image_res;
+        row.structure = "bvh2", row.builder = AccelConfig{}.builder;
+        row.kernels = kernel_choice_summary(KernelChoice{});
         rows.push_back(std::move(row));
     }
 }
@@ -258,25 +337,67 @@ int run_tradeoff(const TradeoffPlan& plan) {
     const TradeoffSizes sizes = sizes_for(plan.quick);
     const Stages stages;
     std::vector<TradeoffRow> rows;
+    ReferenceImages references;
+    MeasuredCache measured;
+    const ObjectScene meshes = leak_test_meshes(sizes.mesh_detail, sizes.tetra_size);
+    const ObjectScene spheres = leak_test_spheres();
+    const KernelChoice moeller{.triangle = TriangleMethod::Moeller}, watertight{.triangle = TriangleMethod::Watertight};
     run_kernel_family({.name = "triangle", .kind = PrimKind::Triangle, .timing_scene = kTriangleScene,
                        .image_scene = kTriangleScene,
-                       .variants = {{"moeller", {.triangle = TriangleMethod::Moeller}},
-                                    {"watertight", {.triangle = TriangleMethod::Watertight}},
-                                    {"plane", {.triangle = TriangleMethod::Plane}}},
-                       .leak_scene = leak_test_meshes(sizes.mesh_detail, sizes.tetra_size),
-                       .count_leaks = count_mesh_leaks},
-                      plan, sizes, stages, rows);
+                       .variants = {variant("moeller", "bvh2", moeller), variant("watertight", "bvh2", watertight),
+                                    variant("plane", "bvh2", {.triangle = TriangleMethod::Plane})},
+                       .leak_scene = &meshes, .count_leaks = count_mesh_leaks},
+                      plan, sizes, stages, references, measured, rows);
     run_kernel_family({.name = "sphere", .kind = PrimKind::Sphere, .timing_scene = kSphereTimingScene,
                        .image_scene = kSphereImageScene,
-                       .variants = {{"algebraic", {.sphere = SphereMethod::Algebraic}},
-                                    {"geometric", {.sphere = SphereMethod::Geometric}},
-                                    {"precise", {.sphere = SphereMethod::Precise}}},
-                       .leak_scene = leak_test_spheres(),
-                       .count_leaks = count_sphere_leaks},
-                      plan, sizes, stages, rows);
-    run_offset_family(plan, sizes, stages, rows);
+                       .variants = {variant("algebraic", "bvh2", {.sphere = SphereMethod::Algebraic}),
+                                    variant("geometric", "bvh2", {.sphere = SphereMethod::Geometric}),
+                                    variant("precise", "bvh2", {.sphere = SphereMethod::Precise})},
+                       .leak_scene = &spheres, .count_leaks = count_sphere_leaks},
+                      plan, sizes, stages, references, measured, rows);
+    // Slabs and reciprocals with watertight triangles, so that a leak is the
+    // traversal's; through BVH2 and through BVH8, whose ordered node test
+    // computes its slabs apart from the BVH2's.
+    KernelChoice plain = watertight, approx = watertight;
+    plain.slabs = SlabMethod::Plain;
+    approx.rcp = RcpMethod::Approx;
+    std::vector<TradeVariant> slabs, rcp;
+    for (const char* structure : {"bvh2", "bvh8"}) {
+        slabs.push_back(variant("plain", structure, plain));
+        slabs.push_back(variant("robust", structure, watertight));
+        rcp.push_back(variant("exact", structure, watertight));
+        rcp.push_back(variant("approx", structure, approx));
+    }
+    run_kernel_family({.name = "slabs", .kind = PrimKind::Triangle, .timing_scene = kTriangleScene,
+                       .image_scene = kTriangleScene, .variants = slabs, .leak_scene = &meshes,
+                       .count_leaks = count_mesh_leaks, .measure_t = false},
+                      plan, sizes, stages, references, measured, rows);
+    run_kernel_family({.name = "rcp", .kind = PrimKind::Triangle, .timing_scene = kTriangleScene,
+                       .image_scene = kTriangleScene, .variants = rcp, .leak_scene = &meshes,
+                       .count_leaks = count_mesh_leaks, .measure_t = false},
+                      plan, sizes, stages, references, measured, rows);
+    // Default kernels: the price and the gain of double on the default test.
+    KernelChoice in_double = moeller;
+    in_double.precision = Precision::Double;
+    run_kernel_family({.name = "precision", .kind = PrimKind::Triangle, .timing_scene = kTriangleScene,
+                       .image_scene = kTriangleScene,
+                       .variants = {variant("float", "bvh2", moeller), variant("double", "bvh2", in_double)},
+                       .leak_scene = &meshes, .count_leaks = count_mesh_leaks},
+                      plan, sizes, stages, references, measured, rows);
+    // Watertight triangles: Moeller's own leaks would hide a builder's (SBVH
+    // clips triangles to split boxes; a box clipped too tight leaks).
+    std::vector<TradeVariant> builders;
+    for (const char* builder : bvh_builder_names()) builders.push_back(variant(builder, "bvh2", watertight, builder));
+    run_kernel_family({.name = "builder", .kind = PrimKind::Triangle, .timing_scene = kTriangleScene,
+                       .image_scene = kTriangleScene, .variants = builders, .leak_scene = &meshes,
+                       .count_leaks = count_mesh_leaks, .measure_t = false, .builds = true},
+                      plan, sizes, stages, references, measured, rows);
+    run_offset_family(plan, sizes, stages, references, rows);
     print_tradeoff_table(stdout, rows);
-    std::printf("not measured (no such variant on this branch): --slabs, --rcp, --precision, --builder\n");
+    std::printf("\nslabs, rcp, builder: watertight triangles, so that a leak is the traversal's or the builder's;\n"
+                "no t error (they leave the primitive test, hence t, unchanged). builder: build ms is the median of\n"
+                "%d one-thread builds of %s, SAH cost of its BVH2. Kernels and structure of each row: --json/--csv.\n",
+                plan.repeat, kTriangleScene);
     if (!plan.json.empty()) write_tradeoff_json(plan.json, rows);
     if (!plan.csv.empty()) write_tradeoff_csv(plan.csv, rows);
     std::fprintf(stderr, "raypack bench --tradeoff%s: %zu rows in %.1f s\n", plan.quick ? " --quick" : "", rows.size(),

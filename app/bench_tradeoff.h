@@ -1,7 +1,8 @@
 #pragma once
 // raypack bench --tradeoff: for every variant of the triangle test, the
-// sphere test and the secondary-ray offset, its throughput and the errors it
-// causes (README, "Speed against accuracy").
+// sphere test, the secondary-ray offset, the slab test, the reciprocal, the
+// precision of the primitive tests and the BVH builder, its throughput and
+// the errors it causes (README, "Speed against accuracy").
 #include <string>
 
 namespace raypack::app {

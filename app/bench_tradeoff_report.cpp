@@ -65,6 +65,12 @@ Json to_json(const TradeoffRow& r) {
     // JSON has no infinity: identical images give psnr_db null and differing_fraction 0.
     j["psnr_db"] = image ? number_or_null(true, r.image->psnr_db) : Json();
     j["differing_fraction"] = image ? Json(r.image->differing_fraction) : Json();
+    // Added after the first schema: at the end, so that column positions hold.
+    j["structure"] = r.structure;
+    j["builder"] = r.builder;
+    j["kernels"] = r.kernels;
+    j["build_ms"] = number_or_null(r.build_ms.has_value(), r.build_ms.value_or(0));
+    j["sah_cost"] = number_or_null(r.sah_cost.has_value(), r.sah_cost.value_or(0));
     return j;
 }
 
@@ -96,10 +102,14 @@ std::string placement_label(const Placement& where) {
 }
 
 void print_tradeoff_table(std::FILE* out, const std::vector<TradeoffRow>& rows) {
-    std::fprintf(out, "%-8s %-10s %9s %17s %12s %21s %14s %8s %9s\n", "family", "variant", "Mrays/s", "(min - max)",
-                 "leak frac", "t ULPs med/p99/max", "self-isect", "PSNR dB", "differ");
+    std::fprintf(out, "%-9s %-10s %-5s %9s %17s %12s %21s %14s %8s %9s %9s %8s\n", "family", "variant", "accel",
+                 "Mrays/s", "(min - max)", "leak frac", "t ULPs med/p99/max", "self-isect", "PSNR dB", "differ",
+                 "build ms", "SAH");
     for (const TradeoffRow& r : rows) {
-        char spread[32], leak[24] = "-", ulps[40] = "-", psnr[16] = "-", differ[16] = "-";
+        char spread[32], leak[24] = "-", ulps[40] = "-", psnr[16] = "-", differ[16] = "-", build[16] = "-",
+                          sah[16] = "-";
+        if (r.build_ms) std::snprintf(build, sizeof build, "%.2f", *r.build_ms);
+        if (r.sah_cost) std::snprintf(sah, sizeof sah, "%.1f", *r.sah_cost);
         std::snprintf(spread, sizeof spread, "(%.2f - %.2f)", r.mrays_per_s_min, r.mrays_per_s_max);
         if (r.leaks && r.leaks->rays() > 0)
             std::snprintf(leak, sizeof leak, "%.3g", double(r.leaks->leaks()) / double(r.leaks->rays()));
@@ -115,8 +125,9 @@ void print_tradeoff_table(std::FILE* out, const std::vector<TradeoffRow>& rows) 
             else std::snprintf(psnr, sizeof psnr, "inf");
             std::snprintf(differ, sizeof differ, "%.4f", r.image->differing_fraction);
         }
-        std::fprintf(out, "%-8s %-10s %9.2f %17s %12s %21s %14s %8s %9s\n", r.family.c_str(), r.variant.c_str(),
-                     r.mrays_per_s_median, spread, leak, ulps, self.c_str(), psnr, differ);
+        std::fprintf(out, "%-9s %-10s %-5s %9.2f %17s %12s %21s %14s %8s %9s %9s %8s\n", r.family.c_str(),
+                     r.variant.c_str(), r.structure.c_str(), r.mrays_per_s_median, spread, leak, ulps, self.c_str(),
+                     psnr, differ, build, sah);
     }
     // The per-placement self-intersections, for the offset rows.
     bool header = false;

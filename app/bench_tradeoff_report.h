@@ -20,8 +20,8 @@ const std::vector<Placement>& self_intersection_placements();
 std::string placement_label(const Placement& where);
 
 struct TradeoffRow {
-    std::string family;   ///< triangle | sphere | offset
-    std::string variant;  ///< moeller, watertight, ... | epsilon, scaled, robust
+    std::string family;   ///< triangle | sphere | slabs | rcp | precision | builder | offset
+    std::string variant;  ///< moeller, watertight, ... | epsilon, scaled, robust | plain, robust | ...
     // Throughput: Mrays/s over `repeat` timed passes.
     std::string throughput_scene, throughput_rays;
     std::size_t timed_rays = 0;
@@ -33,6 +33,11 @@ struct TradeoffRow {
     std::string image_scene;
     int image_width = 0, image_height = 0;
     std::optional<ImageError> image;
+    // Where every figure of the row comes from.
+    std::string structure;  ///< bvh2 | bvh8
+    std::string builder;    ///< binned | sweep | morton | sbvh
+    std::string kernels;    ///< kernel_choice_summary()
+    std::optional<double> build_ms, sah_cost;  ///< builder family: of the throughput scene's structure
 };
 
 void print_tradeoff_table(std::FILE* out, const std::vector<TradeoffRow>& rows);

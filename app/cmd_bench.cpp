@@ -96,9 +96,10 @@ void print_help() {
         "  --offset P     secondary-ray origins of the shadow and diffuse sets: %s (default %s)\n"
         "  --builder B    BVH builder of bvh2, bvh4, bvh8: %s (default binned)\n"
         "  kernel variants of every structure but Embree (which runs its own):\n%s"
-        "  --tradeoff     speed against accuracy of each kernel and offset variant: throughput, leaks\n"
-        "                 at shared edges and vertices, t error in ULPs, self-intersections from\n"
-        "                 scale 1e-4 to 1e6, image error against a double reference (README)\n",
+        "  --tradeoff     speed against accuracy of each triangle, sphere, slab, rcp, precision, builder\n"
+        "                 and offset variant: throughput, leaks at shared edges and vertices, t error\n"
+        "                 in ULPs, self-intersections from scale 1e-4 to 1e6, image error against a\n"
+        "                 double reference (README)\n",
         accel_kinds_list().c_str(), offset_policy_list().c_str(), offset_policy_name(kDefaultOffset),
         bvh_builder_list().c_str(), kernel_options_help().c_str());
 }

@@ -9,10 +9,16 @@
 namespace raypack::app {
 namespace {
 
+/// RFC 4180: a text holding a comma, quote or line break goes in quotes,
+/// its quotes doubled (kernel summaries are comma-separated lists).
 std::string csv_field(const nlohmann::ordered_json& v) {
     if (v.is_null()) return "";
-    if (v.is_string()) return v.get<std::string>();
-    return v.dump();
+    if (!v.is_string()) return v.dump();
+    const std::string text = v.get<std::string>();
+    if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
+    std::string quoted = "\"";
+    for (char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+    return quoted + "\"";
 }
 
 }  // namespace

@@ -1,8 +1,11 @@
 #!/usr/bin/python3
 """Draws `raypack bench --tradeoff --json` results: the trade curves, one PNG
-per family (triangle, sphere, offset), one panel per error measure, each
-variant a point at (error, Mrays/s median) with the min-max spread of the
-timed passes as a vertical bar. Up and left is better.
+per family (triangle, sphere, slabs, rcp, precision, builder, offset), one
+panel per error measure the family has (builder: also SAH cost and build
+time), each variant a point at (error, Mrays/s median) with the min-max
+spread of the timed passes as a vertical bar; where a family runs on several
+structures (slabs, rcp: bvh2 and bvh8), points are labelled "variant
+(structure)". Up and left is better.
 
 usage: scripts/plot_tradeoff.py TRADEOFF.json OUTDIR   (writes OUTDIR/tradeoff_FAMILY.png)
 
@@ -37,6 +40,8 @@ MEASURES = (
     ("self-intersection fraction", lambda r: r.get("self_fraction")),
     ("wrong shadow fraction", shadow_wrong_fraction),
     ("pixels differing from the double reference", lambda r: r.get("differing_fraction")),
+    ("SAH cost of the BVH", lambda r: r.get("sah_cost")),
+    ("build time, ms (one thread)", lambda r: r.get("build_ms")),
 )
 
 
@@ -53,6 +58,8 @@ def load_rows(path):
 
 
 def plot_family(family, rows, out_path):
+    # Files written before the structure column have none: one structure.
+    several = len({r.get("structure") for r in rows}) > 1
     measures = [(label, f) for label, f in MEASURES if any(f(r) is not None for r in rows)]
     fig, axes = plt.subplots(1, len(measures), figsize=(4.2 * len(measures), 3.8), squeeze=False)
     for ax, (label, f) in zip(axes[0], measures):
@@ -66,7 +73,8 @@ def plot_family(family, rows, out_path):
             x = error if error > 0 else floor
             y = r["mrays_per_s_median"]
             ax.errorbar([x], [y], yerr=[[y - r["mrays_per_s_min"]], [r["mrays_per_s_max"] - y]], fmt="o", capsize=3)
-            ax.annotate(r["variant"] + (" (0)" if error == 0 else ""), (x, y), textcoords="offset points",
+            name = r["variant"] + (f" ({r.get('structure')})" if several else "")
+            ax.annotate(name + (" (0)" if error == 0 else ""), (x, y), textcoords="offset points",
                         xytext=(5, 5), fontsize=8)
         if log:
             ax.set_xscale("log")
@@ -76,7 +84,10 @@ def plot_family(family, rows, out_path):
         ax.grid(True, which="both", alpha=0.3)
     scene = rows[0].get("throughput_scene", "")
     kind = rows[0].get("throughput_rays", "")
-    fig.suptitle(f"{family}: throughput ({kind} rays, {scene}) against error")
+    kernels = {r.get("kernels") for r in rows}
+    # One kernel choice for the whole family (builder) is worth the title.
+    shared = f"\n{kernels.pop()}" if len(kernels) == 1 and None not in kernels else ""
+    fig.suptitle(f"{family}: throughput ({kind} rays, {scene}) against error{shared}")
     fig.tight_layout()
     fig.savefig(out_path, dpi=100)
     plt.close(fig)
