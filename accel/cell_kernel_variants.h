@@ -1,11 +1,10 @@
 #pragma once
 // The traversal variants `--slabs` and `--rcp` (KernelChoice) as the cell
 // structures (grid, octree, k-d tree) use them: one plane distance in both
-// slab forms, and the approximate reciprocal for packets.
+// slab forms, and the approximate reciprocal of single rays.
 #include <type_traits>
 
 #include "kernels/aabb.h"
-#include "kernels/ray_packet.h"
 #include "kernels/simd.h"
 
 namespace raypack {
@@ -38,22 +37,6 @@ RAYPACK_INLINE Vec3f ray_reciprocal(const Vec3f& dir, RcpMethod rcp) {
     if (rcp == RcpMethod::Exact) [[likely]]
         return reciprocal(dir);
     return approx_ray_reciprocal(dir);
-}
-
-/// Overwrites the packet's rdir (load_packet computes it exactly) with
-/// reciprocal(dir, rcp), lane by lane at width 1 as the single-ray walks
-/// compute it, so that packets and single rays keep the same bits.
-template <int K>
-void use_rcp(RayPacket<K>& p, RcpMethod rcp) {
-    if (rcp == RcpMethod::Exact) return;
-    using F = vfloat<K>;
-    alignas(64) float d[3][K], r[3][K];
-    for (int a = 0; a < 3; ++a) store_lanes(d[a], p.dir[a]);
-    for (int l = 0; l < K; ++l) {
-        const Vec3f rd = reciprocal(Vec3f{d[0][l], d[1][l], d[2][l]}, rcp);
-        r[0][l] = rd.x, r[1][l] = rd.y, r[2][l] = rd.z;
-    }
-    p.rdir = {load_lanes<F>(r[0]), load_lanes<F>(r[1]), load_lanes<F>(r[2])};
 }
 
 }  // namespace raypack

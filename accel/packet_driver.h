@@ -43,10 +43,4 @@ void trace_in_packets(std::span<const Rayf> rays, std::span<Hitf> hits, RcpMetho
     }
 }
 
-/// Exact reciprocals (the callers that do not take `--rcp` yet).
-template <int K, bool AnyHit, class TracePacket>
-void trace_in_packets(std::span<const Rayf> rays, std::span<Hitf> hits, TracePacket&& trace_packet) {
-    trace_in_packets<K, AnyHit>(rays, hits, RcpMethod::Exact, std::forward<TracePacket>(trace_packet));
-}
-
 }  // namespace raypack

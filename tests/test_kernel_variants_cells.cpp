@@ -28,6 +28,7 @@
 #include "accel/accel.h"
 #include "accel/brute/brute_force.h"
 #include "accel/cell_kernel_variants.h"
+#include "kernels/ray_packet.h"
 #include "accel/grid/grid_accel.h"
 #include "accel/kdtree/kdtree_accel.h"
 #include "accel/octree/octree_accel.h"
@@ -415,10 +416,10 @@ INSTANTIATE_TEST_SUITE_P(, KernelVariantsCells, ::testing::ValuesIn(kScenes), pa
 
 // The hits above cannot tell an approximate rdir from an exact one (the
 // structures' margins absorb a few ulps), so the packets' rdir is checked
-// here: use_rcp() gives every lane the single ray's reciprocal(dir, rcp),
+// here: load_packet() gives every lane the single ray's reciprocal(dir, rcp),
 // and approximate ones do differ from exact ones.
 template <int K>
-void check_use_rcp(std::mt19937& rng) {
+void check_packet_rcp(std::mt19937& rng) {
     std::vector<Rayf> rays(K);
     int approx_differs = 0;
     for (int round = 0; round < 200; ++round) {
@@ -429,8 +430,7 @@ void check_use_rcp(std::mt19937& rng) {
         }
         for (RcpMethod rcp : {RcpMethod::Exact, RcpMethod::Approx}) {
             vmask<K> valid;
-            RayPacket<K> p = load_packet<K>(rays, valid);
-            use_rcp<K>(p, rcp);
+            RayPacket<K> p = load_packet<K>(rays, valid, rcp);
             alignas(64) float r[3][K];
             for (int a = 0; a < 3; ++a) store_lanes(r[a], p.rdir[a]);
             for (int l = 0; l < K; ++l) {
@@ -447,13 +447,13 @@ void check_use_rcp(std::mt19937& rng) {
 TEST(KernelVariantsCellsRcp, PacketsGetTheSingleRaysReciprocals) {
     std::mt19937 rng(11);
 #if defined(__SSE4_2__)
-    check_use_rcp<4>(rng);
+    check_packet_rcp<4>(rng);
 #endif
 #if defined(__AVX2__)
-    check_use_rcp<8>(rng);
+    check_packet_rcp<8>(rng);
 #endif
 #if defined(__AVX512BW__)
-    check_use_rcp<16>(rng);
+    check_packet_rcp<16>(rng);
 #endif
 }
 

@@ -102,10 +102,9 @@ void grid_trace_packets(const Grid& grid, const Scene& scene, KernelChoice kerne
     const PacketPrimitiveIntersector<F> isect{&scene, kernels};
     // The slab form is chosen once for all packets, rdir once per packet.
     auto run = [&]<SlabMethod Slabs>(SlabTag<Slabs>) {
-        trace_in_packets<K, AnyHit>(rays, hits, [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid,
+        trace_in_packets<K, AnyHit>(rays, hits, kernels.rcp, [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid,
                                                     vmask<K>& occluded) {
             if (grid.empty()) return;
-            use_rcp<K>(ray, kernels.rcp);
             trace_packet<K, AnyHit, Slabs>(grid, isect, ray, hit, valid, occluded);
         });
     };

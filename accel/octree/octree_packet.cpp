@@ -154,9 +154,8 @@ void octree_trace_packets(const Octree& tree, const Scene& scene, KernelChoice k
     const PacketPrimitiveIntersector<F> isect{&scene, kernels};
     // The slab form is chosen once for all packets, rdir once per packet.
     auto run = [&]<SlabMethod Slabs>(SlabTag<Slabs>) {
-        trace_in_packets<K, AnyHit>(rays, hits, [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid,
+        trace_in_packets<K, AnyHit>(rays, hits, kernels.rcp, [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid,
                                                     vmask<K>& occluded) {
-            use_rcp<K>(ray, kernels.rcp);
             trace_packet<K, AnyHit, Slabs>(tree, isect, ray, hit, valid, occluded);
         });
     };
