@@ -1,18 +1,25 @@
 #pragma once
 // Helpers shared by the tests that check a structure against the brute-force
-// oracle: readable ray and hit descriptions, random rays, shadow rays, test
-// parameter names.
+// oracle: readable ray and hit descriptions, camera, random and shadow rays,
+// comparisons with the oracle's answers (Mismatches), test parameter names.
 #include <gtest/gtest.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <iomanip>
 #include <random>
+#include <span>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "accel/accel.h"
 #include "accel/primitive_intersector.h"
 #include "kernels/aabb.h"
+#include "render/camera_rays.h"
 #include "scene/scene.h"
 
 namespace raypack::oracle_harness {
@@ -56,6 +63,161 @@ inline Box3f grown(Box3f b, float f) {
     return b;
 }
 
+/// Closest hits of `rays` through Accel::intersect_packets with `width` (1:
+/// single rays), in batches of 256 on all cores.
+inline std::vector<Hitf> trace_hits(const Accel& accel, const std::vector<Rayf>& rays, int width = 1) {
+    std::vector<Hitf> hits(rays.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 256), [&](const auto& r) {
+        accel.intersect_packets(width, std::span<const Rayf>(rays).subspan(r.begin(), r.size()),
+                                std::span<Hitf>(hits).subspan(r.begin(), r.size()));
+    });
+    return hits;
+}
+
+/// Occlusion answers of `rays` through Accel::occluded_packets, as trace_hits().
+inline std::vector<std::uint8_t> trace_occlusion(const Accel& accel, const std::vector<Rayf>& rays, int width = 1) {
+    std::vector<std::uint8_t> occ(rays.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 256), [&](const auto& r) {
+        accel.occluded_packets(width, std::span<const Rayf>(rays).subspan(r.begin(), r.size()),
+                               std::span<std::uint8_t>(occ).subspan(r.begin(), r.size()));
+    });
+    return occ;
+}
+
+/// One ray through the centre of every pixel of a size x size image of the
+/// scene's camera, row by row.
+inline std::vector<Rayf> camera_rays(const Scene& scene, int size) {
+    const CameraFrame f = make_camera_frame(scene.camera, size, size);
+    std::vector<Rayf> rays;
+    rays.reserve(std::size_t(size) * size);
+    for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x) rays.push_back(camera_ray(f, float(x) + 0.5f, float(y) + 0.5f));
+    return rays;
+}
+
+/// n rays with random origins in `origins`, random directions, and every
+/// second one (odd index) a tfar drawn uniformly from [0, max_tfar).
+inline std::vector<Rayf> random_rays_in(std::mt19937& rng, const Box3f& origins, float max_tfar, int n) {
+    std::uniform_real_distribution<float> u(0, 1);
+    std::vector<Rayf> rays(static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i) {
+        rays[i].org = random_point(rng, origins);
+        rays[i].dir = random_direction(rng);
+        if (i % 2) rays[i].tfar = u(rng) * max_tfar;
+    }
+    return rays;
+}
+
+/// random_rays_in() with origins in the scene box grown by `grow` of its
+/// extent on every side, and finite tfar up to the (ungrown) box's diagonal.
+inline std::vector<Rayf> random_rays(const Scene& scene, std::mt19937& rng, int n, float grow = 0.0f) {
+    const Box3f box = scene_bounds(scene);
+    return random_rays_in(rng, grow == 0.0f ? box : grown(box, grow), length(box.extent()), n);
+}
+
+/// A unit direction along `axis` with sign `sign`, the other components +-0.
+inline Vec3f axis_direction(std::mt19937& rng, int axis, float sign) {
+    Vec3f d{signed_zero(rng), signed_zero(rng), signed_zero(rng)};
+    d[axis] = sign;
+    return d;
+}
+
+// Rays from a structure's own planes: `plane(axis)` returns one of its
+// planes across `axis` (drawing from the caller's rng), `corner()` a point
+// whose three coordinates are such planes.
+
+/// Appends n axis-parallel rays along lines where two planes meet (a
+/// corner() with the coordinate along axis i % 3 moved outside `box` by a
+/// tenth of its diagonal), pointing into the box.
+template <class Corner>
+void append_edge_rays(std::vector<Rayf>& rays, std::mt19937& rng, const Box3f& box, Corner&& corner, int n) {
+    const float diag = length(box.extent());
+    for (int i = 0; i < n; ++i) {
+        const int a = i % 3;
+        const float sign = (i / 3) % 2 ? 1.0f : -1.0f;
+        Rayf r;
+        r.org = corner();
+        r.org[a] = sign > 0 ? box.lo[a] - 0.1f * diag : box.hi[a] + 0.1f * diag;
+        r.dir = axis_direction(rng, a, sign);
+        rays.push_back(r);
+    }
+}
+
+/// Appends n rays inside a plane across axis i % 3 (that direction
+/// component +-0) from random points of `box`.
+template <class Plane>
+void append_in_plane_rays(std::vector<Rayf>& rays, std::mt19937& rng, const Box3f& box, Plane&& plane, int n) {
+    for (int i = 0; i < n; ++i) {
+        const int a = i % 3;
+        Rayf r;
+        r.org = random_point(rng, box);
+        r.org[a] = plane(a);
+        r.dir = random_direction(rng);
+        r.dir[a] = signed_zero(rng);
+        rays.push_back(r);
+    }
+}
+
+/// Appends n rays from corner()s in random directions (every third) and
+/// through them from random points of `box` grown by half.
+template <class Corner>
+void append_corner_rays(std::vector<Rayf>& rays, std::mt19937& rng, const Box3f& box, Corner&& corner, int n) {
+    for (int i = 0; i < n; ++i) {
+        Rayf r;
+        const Vec3f c = corner();
+        if (i % 3 == 0) {
+            r.org = c;
+            r.dir = random_direction(rng);
+        } else {
+            r.org = random_point(rng, grown(box, 0.5f));
+            r.dir = c - r.org;
+            if (!(dot(r.dir, r.dir) > 0)) r.dir = {1, 1, 1};
+        }
+        rays.push_back(r);
+    }
+}
+
+/// Appends n rays from random points on the faces of `box` (face i % 6 in
+/// turn): inwards, and every fourth along the face (that direction
+/// component +-0).
+inline void append_face_rays(std::vector<Rayf>& rays, std::mt19937& rng, const Box3f& box, int n) {
+    for (int i = 0; i < n; ++i) {
+        const int a = i % 3;
+        const bool hi = (i / 3) % 2;
+        Rayf r;
+        r.org = random_point(rng, box);
+        r.org[a] = hi ? box.hi[a] : box.lo[a];
+        r.dir = random_direction(rng);
+        r.dir[a] = i % 4 == 0 ? signed_zero(rng) : (hi ? -1.0f : 1.0f) * std::fabs(r.dir[a]);
+        rays.push_back(r);
+    }
+}
+
+/// Appends n rays from random points of `origins` aimed exactly at a random
+/// primitive's first triangle vertex, sphere pole or cone apex (none for an
+/// empty scene).
+inline void append_vertex_rays(std::vector<Rayf>& rays, const Scene& scene, std::mt19937& rng, const Box3f& origins,
+                               int n) {
+    const auto nprims = std::uint32_t(scene.primitive_count());
+    for (int i = 0; i < n && nprims; ++i) {
+        const PrimRef ref = scene.prims[rng() % nprims];
+        Vec3f target;
+        if (ref.kind == PrimKind::Triangle) {
+            target = scene.triangles.p0[ref.index];
+        } else if (ref.kind == PrimKind::Sphere) {
+            target = scene.spheres.center[ref.index];
+            target[int(rng() % 3)] += scene.spheres.radius[ref.index];
+        } else {
+            target = scene.cones.apex[ref.index];
+        }
+        Rayf r;
+        r.org = random_point(rng, origins);
+        r.dir = target - r.org;
+        if (!(dot(r.dir, r.dir) > 0)) r.dir = {0, 0, 1};
+        rays.push_back(r);
+    }
+}
+
 inline std::vector<Rayf> shadow_rays(const Scene& scene, const std::vector<Rayf>& rays, const std::vector<Hitf>& hits) {
     std::vector<Rayf> out;
     for (std::size_t i = 0; i < rays.size(); ++i) {
@@ -97,6 +259,61 @@ inline bool hit_inside_own_box(const Scene& scene, const KernelChoice& kernels, 
         if (isect.intersect(p, r, h) && !outside_own_box(scene, ray, p, h.t)) return true;
     }
     return false;
+}
+
+/// The same hit or miss; the same primitive at the same t, or another one
+/// at t within relative 1e-5 (a shared edge or vertex).
+inline bool same_closest_hit(const Hitf& want, const Hitf& got) {
+    if (want.found() != got.found()) return false;
+    if (!want.found()) return true;
+    return want.prim == got.prim ? want.t == got.t
+                                 : std::fabs(want.t - got.t) <= 1e-5f * std::max(std::fabs(want.t), std::fabs(got.t));
+}
+
+struct Mismatches {
+    std::size_t count = 0;
+    std::size_t excused = 0;  ///< oracle hits outside their primitive's box (see outside_own_box)
+    std::string first;        ///< the first few, with reproducing rays
+};
+
+/// Closest hits `got` against the oracle's `want` (same_closest_hit); a
+/// missed nearer oracle hit outside its primitive's box is excused. The
+/// first `examples` mismatches are described in Mismatches::first.
+inline Mismatches compare_hits(const Scene& scene, const std::vector<Rayf>& rays, const std::vector<Hitf>& want,
+                               const std::vector<Hitf>& got, std::size_t examples) {
+    Mismatches m;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        if (same_closest_hit(want[i], got[i])) continue;
+        // Missed the oracle's (nearer) hit: excused if that hit is outside its box.
+        if (want[i].found() && (!got[i].found() || got[i].t > want[i].t) &&
+            outside_own_box(scene, rays[i], want[i].prim, want[i].t)) {
+            ++m.excused;
+            continue;
+        }
+        if (++m.count <= examples)
+            m.first += "\n  ray " + std::to_string(i) + ": " + describe(rays[i]) + "\n    brute " + describe(want[i]) +
+                       ", got " + describe(got[i]);
+    }
+    return m;
+}
+
+/// Occlusion answers `got` against the oracle's `want`; an oracle "occluded"
+/// is excused when no hit lies inside its primitive's box.
+inline Mismatches compare_occluded(const Scene& scene, const KernelChoice& kernels, const std::vector<Rayf>& rays,
+                                   const std::vector<std::uint8_t>& want, const std::vector<std::uint8_t>& got,
+                                   std::size_t examples) {
+    Mismatches m;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        if (want[i] == got[i]) continue;
+        if (want[i] && !hit_inside_own_box(scene, kernels, rays[i])) {
+            ++m.excused;
+            continue;
+        }
+        if (++m.count <= examples)
+            m.first += "\n  ray " + std::to_string(i) + ": " + describe(rays[i]) + "\n    brute " +
+                       (want[i] ? "occluded" : "clear") + ", got " + (got[i] ? "occluded" : "clear");
+    }
+    return m;
 }
 
 inline std::string param_name(const ::testing::TestParamInfo<std::string>& info) {

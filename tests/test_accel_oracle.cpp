@@ -69,30 +69,6 @@ bool same_t(float a, float b, float rel) { return std::fabs(a - b) <= rel * std:
 
 // ---- Ray sets ------------------------------------------------------------------
 
-std::vector<Rayf> camera_rays(const Scene& scene, int size) {
-    const CameraFrame f = make_camera_frame(scene.camera, size, size);
-    std::vector<Rayf> rays;
-    rays.reserve(std::size_t(size) * size);
-    for (int y = 0; y < size; ++y)
-        for (int x = 0; x < size; ++x) rays.push_back(camera_ray(f, float(x) + 0.5f, float(y) + 0.5f));
-    return rays;
-}
-
-/// Origins uniform in the scene box, directions uniform on the sphere; half
-/// of them with a finite tfar so that tfar culling is exercised.
-std::vector<Rayf> random_rays(const Scene& scene, std::mt19937& rng, int n) {
-    const Box3f box = scene_bounds(scene);
-    const float diag = length(box.extent());
-    std::uniform_real_distribution<float> u(0, 1);
-    std::vector<Rayf> rays(n);
-    for (int i = 0; i < n; ++i) {
-        rays[i].org = random_point(rng, box);
-        rays[i].dir = random_direction(rng);
-        if (i % 2) rays[i].tfar = u(rng) * diag;
-    }
-    return rays;
-}
-
 /// A point of primitive p that lies on its bounding box (a vertex, the top of
 /// a sphere, the rim of a cone end): rays through such points test whether the
 /// structure's boxes are conservative.
@@ -140,20 +116,7 @@ std::vector<Rayf> adversarial_rays(const Scene& scene, std::mt19937& rng) {
     }
     // 2. Origins exactly on the faces of the scene box, directions into the
     //    box and directions parallel to the face (component +-0).
-    for (int i = 0; i < 600; ++i) {
-        const int axis = i % 3;
-        const bool hi = (i / 3) % 2;
-        Rayf r;
-        r.org = random_point(rng, box);
-        r.org[axis] = hi ? box.hi[axis] : box.lo[axis];
-        r.dir = random_direction(rng);
-        if (i % 4 == 0) {
-            r.dir[axis] = signed_zero(rng);
-        } else {
-            r.dir[axis] = (hi ? -1.0f : 1.0f) * std::fabs(r.dir[axis]);
-        }
-        rays.push_back(r);
-    }
+    append_face_rays(rays, rng, box, 600);
     // 3. Rays grazing sphere silhouettes (distance r(1 - 1e-6), r, r(1 + 1e-6)
     //    from the centre) and aimed at triangle vertices and cone rims.
     for (int i = 0; i < 900; ++i) {

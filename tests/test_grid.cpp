@@ -111,26 +111,9 @@ void expect_agreement(const Scene& scene, const Accel& grid, const std::vector<R
 
 // ---- Ray sets -----------------------------------------------------------------------
 
-std::vector<Rayf> camera_rays(const Scene& scene, int size) {
-    const CameraFrame f = make_camera_frame(scene.camera, size, size);
-    std::vector<Rayf> rays;
-    for (int y = 0; y < size; ++y)
-        for (int x = 0; x < size; ++x) rays.push_back(camera_ray(f, float(x) + 0.5f, float(y) + 0.5f));
-    return rays;
-}
-
-std::vector<Rayf> random_rays(const Scene& scene, std::mt19937& rng, int n) {
-    const Box3f box = scene_bounds(scene);
-    const float diag = length(box.extent());
-    std::uniform_real_distribution<float> u(0, 1);
-    std::vector<Rayf> rays(n);
-    for (int i = 0; i < n; ++i) {
-        rays[i].org = random_point(rng, grown(box, 0.2f));
-        rays[i].dir = random_direction(rng);
-        if (i % 2) rays[i].tfar = u(rng) * diag;
-    }
-    return rays;
-}
+/// random_rays() (tests/oracle_harness.h) draws origins in the scene box
+/// grown by this fraction per side, so that some start outside the structure.
+constexpr float kOriginGrowth = 0.2f;
 
 /// Rays that make a 3D-DDA stumble, built from the grid's own planes.
 std::vector<Rayf> grid_adversarial_rays(const GridGeometry& g, const Scene& scene, std::mt19937& rng) {
@@ -140,37 +123,16 @@ std::vector<Rayf> grid_adversarial_rays(const GridGeometry& g, const Scene& scen
     std::uniform_real_distribution<float> u(0, 1);
     auto plane = [&](int axis) { return g.plane(axis, int(rng() % std::uint32_t(g.res[axis] + 1))); };
     auto corner = [&] { return Vec3f{plane(0), plane(1), plane(2)}; };
-    auto axis_dir = [&](int axis, float sign) {
-        Vec3f d{signed_zero(rng), signed_zero(rng), signed_zero(rng)};
-        d[axis] = sign;
-        return d;
-    };
     // 1. Along cell edges: the two other coordinates exactly on cell planes,
     //    axis-parallel, from outside the grid.
-    for (int i = 0; i < 600; ++i) {
-        const int a = i % 3;
-        const float sign = (i / 3) % 2 ? 1.0f : -1.0f;
-        Rayf r;
-        r.org = corner();
-        r.org[a] = sign > 0 ? box.lo[a] - 0.1f * diag : box.hi[a] + 0.1f * diag;
-        r.dir = axis_dir(a, sign);
-        rays.push_back(r);
-    }
+    append_edge_rays(rays, rng, box, corner, 600);
     // 2. Inside a cell plane (that direction component +-0), from inside the grid.
-    for (int i = 0; i < 600; ++i) {
-        const int a = i % 3;
-        Rayf r;
-        r.org = random_point(rng, box);
-        r.org[a] = plane(a);
-        r.dir = random_direction(rng);
-        r.dir[a] = signed_zero(rng);
-        rays.push_back(r);
-    }
+    append_in_plane_rays(rays, rng, box, plane, 600);
     // 3. Axis-parallel from random origins in and around the grid; half with a finite tfar.
     for (int i = 0; i < 600; ++i) {
         Rayf r;
         r.org = random_point(rng, grown(box, 0.1f));
-        r.dir = axis_dir(i % 3, (i / 3) % 2 ? 1.0f : -1.0f);
+        r.dir = axis_direction(rng, i % 3, (i / 3) % 2 ? 1.0f : -1.0f);
         if (i % 2) r.tfar = u(rng) * diag;
         rays.push_back(r);
     }
@@ -184,19 +146,7 @@ std::vector<Rayf> grid_adversarial_rays(const GridGeometry& g, const Scene& scen
         rays.push_back(r);
     }
     // 5. Through cell corners, and from cell corners.
-    for (int i = 0; i < 900; ++i) {
-        Rayf r;
-        const Vec3f c = corner();
-        if (i % 3 == 0) {
-            r.org = c;
-            r.dir = random_direction(rng);
-        } else {
-            r.org = random_point(rng, grown(box, 0.5f));
-            r.dir = c - r.org;
-            if (!(dot(r.dir, r.dir) > 0)) r.dir = {1, 1, 1};
-        }
-        rays.push_back(r);
-    }
+    append_corner_rays(rays, rng, box, corner, 900);
     // 6. Along cell diagonals: ties between all three axes at every step.
     for (int i = 0; i < 300; ++i) {
         Rayf r;
@@ -216,35 +166,9 @@ std::vector<Rayf> grid_adversarial_rays(const GridGeometry& g, const Scene& scen
         rays.push_back(r);
     }
     // 8. On the grid's faces, the far ones included: inwards and along the face.
-    for (int i = 0; i < 300; ++i) {
-        const int a = i % 3;
-        const bool hi = (i / 3) % 2;
-        Rayf r;
-        r.org = random_point(rng, box);
-        r.org[a] = hi ? box.hi[a] : box.lo[a];
-        r.dir = random_direction(rng);
-        r.dir[a] = i % 4 == 0 ? signed_zero(rng) : (hi ? -1.0f : 1.0f) * std::fabs(r.dir[a]);
-        rays.push_back(r);
-    }
+    append_face_rays(rays, rng, box, 300);
     // 9. Aimed at triangle vertices and sphere poles, which lie on cell planes only by chance.
-    const auto nprims = std::uint32_t(scene.primitive_count());
-    for (int i = 0; i < 300; ++i) {
-        const PrimRef ref = scene.prims[rng() % nprims];
-        Vec3f target;
-        if (ref.kind == PrimKind::Triangle) {
-            target = scene.triangles.p0[ref.index];
-        } else if (ref.kind == PrimKind::Sphere) {
-            target = scene.spheres.center[ref.index];
-            target[int(rng() % 3)] += scene.spheres.radius[ref.index];
-        } else {
-            target = scene.cones.apex[ref.index];
-        }
-        Rayf r;
-        r.org = random_point(rng, grown(box, 0.2f));
-        r.dir = target - r.org;
-        if (!(dot(r.dir, r.dir) > 0)) r.dir = {0, 0, 1};
-        rays.push_back(r);
-    }
+    append_vertex_rays(rays, scene, rng, grown(box, 0.2f), 300);
     return rays;
 }
 
@@ -277,7 +201,7 @@ TEST_P(Grid, MatchesBruteForce) {
 
     const std::vector<Rayf> camera = camera_rays(scene, 64);
     expect_agreement(scene, grid, camera, GetParam() + " camera");
-    expect_agreement(scene, grid, random_rays(scene, rng, 2000), GetParam() + " random");
+    expect_agreement(scene, grid, random_rays(scene, rng, 2000, kOriginGrowth), GetParam() + " random");
     expect_agreement(scene, grid, grid_adversarial_rays(grid.grid().geometry, scene, rng), GetParam() + " adversarial");
     const std::vector<Rayf> shadows = shadow_rays(scene, camera, trace(brute, camera));
     std::size_t n = 0;
@@ -334,7 +258,7 @@ TEST_F(Grid, OnePrimitiveOfEachKind) {
         const auto grid = make_grid(scene);
         EXPECT_GE(grid->cell_count(), 1u);
         for (int r : grid->resolution()) EXPECT_GE(r, 1);
-        std::vector<Rayf> rays = random_rays(scene, rng, 500);
+        std::vector<Rayf> rays = random_rays(scene, rng, 500, kOriginGrowth);
         const std::vector<Rayf> adv = grid_adversarial_rays(grid->grid().geometry, scene, rng);
         rays.insert(rays.end(), adv.begin(), adv.end());
         expect_agreement(scene, *grid, rays, "one " + std::to_string(int(scene.prims[0].kind)));
@@ -389,7 +313,7 @@ TEST_F(Grid, FlatScenes) {
         EXPECT_GT(per_prim, 0.5 * GridConfig{}.lambda);
         EXPECT_LT(per_prim, 2.0 * GridConfig{}.lambda);
 
-        std::vector<Rayf> rays = random_rays(scene, rng, 1000);
+        std::vector<Rayf> rays = random_rays(scene, rng, 1000, kOriginGrowth);
         const std::vector<Rayf> adv = grid_adversarial_rays(g, scene, rng);
         rays.insert(rays.end(), adv.begin(), adv.end());
         std::uniform_real_distribution<float> u(0, 1);
@@ -429,7 +353,7 @@ TEST_F(Grid, PrimitivesSpanningManyCells) {
     std::vector<std::size_t> cells_of(scene.primitive_count(), 0);
     for (std::uint32_t p : grid->grid().refs) ++cells_of[p];
     for (std::uint32_t p = 2000; p < 2004; ++p) EXPECT_GT(cells_of[p], 50u) << p;
-    std::vector<Rayf> rays = random_rays(scene, rng, 3000);
+    std::vector<Rayf> rays = random_rays(scene, rng, 3000, kOriginGrowth);
     const std::vector<Rayf> adv = grid_adversarial_rays(grid->grid().geometry, scene, rng);
     rays.insert(rays.end(), adv.begin(), adv.end());
     expect_agreement(scene, *grid, rays, "spanning");
@@ -447,7 +371,7 @@ TEST_F(Grid, ReferenceCapCoarsensTheGrid) {
     const auto grid = make_grid(scene, gc);
     EXPECT_LE(grid->reference_count(), gc.max_references);
     EXPECT_LT(grid->lambda(), gc.lambda);
-    expect_agreement(scene, *grid, random_rays(scene, rng, 1000), "capped");
+    expect_agreement(scene, *grid, random_rays(scene, rng, 1000, kOriginGrowth), "capped");
     // An absurd density is held at max_cells.
     gc = {};
     gc.lambda = 1e9f;
@@ -853,7 +777,7 @@ TEST_F(Grid, PacketDdaWalksLikeSingleRays) {
         const auto grid = make_grid(scene);
         const GridGeometry& g = grid->grid().geometry;
         std::vector<Rayf> rays = grid_adversarial_rays(g, scene, rng);
-        const std::vector<Rayf> random = random_rays(scene, rng, 1000);
+        const std::vector<Rayf> random = random_rays(scene, rng, 1000, kOriginGrowth);
         rays.insert(rays.end(), random.begin(), random.end());
         if constexpr (kWidthCompiled<4>) expect_packet_walks_equal<4>(g, rays);
         if constexpr (kWidthCompiled<8>) expect_packet_walks_equal<8>(g, rays);
@@ -880,7 +804,7 @@ TEST_F(Grid, PacketsEqualSingleRays) {
             no_mailbox.mailbox = false;
             const GridAccel grid(scene, config, no_mailbox);
             std::vector<Rayf> rays = camera_rays(scene, 40);
-            const std::vector<Rayf> random = random_rays(scene, rng, 800);
+            const std::vector<Rayf> random = random_rays(scene, rng, 800, kOriginGrowth);
             const std::vector<Rayf> adv = grid_adversarial_rays(grid.grid().geometry, scene, rng);
             rays.insert(rays.end(), random.begin(), random.end());
             rays.insert(rays.end(), adv.begin(), adv.end());

@@ -35,25 +35,6 @@ namespace {
 
 // ---- Tracing and comparing --------------------------------------------------------
 
-/// Closest hits of `rays` in packets of `width` (1: single rays), on both cores.
-std::vector<Hitf> trace(const Accel& accel, const std::vector<Rayf>& rays, int width = 1) {
-    std::vector<Hitf> hits(rays.size());
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 256), [&](const auto& r) {
-        accel.intersect_packets(width, std::span<const Rayf>(rays).subspan(r.begin(), r.size()),
-                                std::span<Hitf>(hits).subspan(r.begin(), r.size()));
-    });
-    return hits;
-}
-
-std::vector<std::uint8_t> trace_occluded(const Accel& accel, const std::vector<Rayf>& rays, int width = 1) {
-    std::vector<std::uint8_t> occ(rays.size());
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 256), [&](const auto& r) {
-        accel.occluded_packets(width, std::span<const Rayf>(rays).subspan(r.begin(), r.size()),
-                               std::span<std::uint8_t>(occ).subspan(r.begin(), r.size()));
-    });
-    return occ;
-}
-
 /// Closest hits that agree exactly: same hit or miss; the same primitive at
 /// the bit-identical t; another primitive only at a t within 1e-5 (a shared
 /// edge or vertex, where either is right).
@@ -95,7 +76,7 @@ void expect_packets_equal_single(const Accel& tree, const std::vector<Rayf>& ray
                                  const std::vector<std::uint8_t>& single_occ, const std::string& what) {
     for (int width : {4, 8, 16}) {
         if (!tree.supports_packet(width)) continue;
-        const std::vector<Hitf> got = trace(tree, rays, width);
+        const std::vector<Hitf> got = trace_hits(tree, rays, width);
         std::size_t differ = 0;
         std::string first;
         for (std::size_t i = 0; i < rays.size(); ++i) {
@@ -111,7 +92,7 @@ void expect_packets_equal_single(const Accel& tree, const std::vector<Rayf>& ray
         EXPECT_EQ(differ, 0u) << what << " width " << width << ": " << differ << " of " << rays.size()
                               << " packet hits differ from single rays" << first;
         std::size_t n = 0;
-        const std::string occ = occlusion_mismatches(rays, single_occ, trace_occluded(tree, rays, width), n);
+        const std::string occ = occlusion_mismatches(rays, single_occ, trace_occlusion(tree, rays, width), n);
         EXPECT_EQ(n, 0u) << what << " width " << width << ": " << n << " packet occlusion answers differ" << occ;
     }
 }
@@ -120,8 +101,8 @@ void expect_packets_equal_single(const Accel& tree, const std::vector<Rayf>& ray
 /// against single rays.
 void expect_agreement(const Scene& scene, const Accel& tree, const std::vector<Rayf>& rays, const std::string& what) {
     const BruteForce brute(scene, KernelChoice{});
-    const std::vector<Hitf> truth = trace(brute, rays);
-    const std::vector<Hitf> got = trace(tree, rays);
+    const std::vector<Hitf> truth = trace_hits(brute, rays);
+    const std::vector<Hitf> got = trace_hits(tree, rays);
     std::size_t n = 0;
     const std::string hits = hit_mismatches(rays, truth, got, n);
     EXPECT_EQ(n, 0u) << what << ": " << n << " of " << rays.size() << " closest hits differ" << hits;
@@ -129,7 +110,7 @@ void expect_agreement(const Scene& scene, const Accel& tree, const std::vector<R
     // ray's [tnear, tfar], which is its occlusion answer.
     std::vector<std::uint8_t> occluded(rays.size());
     for (std::size_t i = 0; i < rays.size(); ++i) occluded[i] = truth[i].found() ? 1 : 0;
-    const std::vector<std::uint8_t> got_occ = trace_occluded(tree, rays);
+    const std::vector<std::uint8_t> got_occ = trace_occlusion(tree, rays);
     const std::string occ = occlusion_mismatches(rays, occluded, got_occ, n);
     EXPECT_EQ(n, 0u) << what << ": " << n << " of " << rays.size() << " occlusion answers differ" << occ;
     expect_packets_equal_single(tree, rays, got, got_occ, what);
@@ -137,26 +118,9 @@ void expect_agreement(const Scene& scene, const Accel& tree, const std::vector<R
 
 // ---- Ray sets -----------------------------------------------------------------------
 
-std::vector<Rayf> camera_rays(const Scene& scene, int size) {
-    const CameraFrame f = make_camera_frame(scene.camera, size, size);
-    std::vector<Rayf> rays;
-    for (int y = 0; y < size; ++y)
-        for (int x = 0; x < size; ++x) rays.push_back(camera_ray(f, float(x) + 0.5f, float(y) + 0.5f));
-    return rays;
-}
-
-std::vector<Rayf> random_rays(const Scene& scene, std::mt19937& rng, int n) {
-    const Box3f box = scene_bounds(scene);
-    const float diag = length(box.extent());
-    std::uniform_real_distribution<float> u(0, 1);
-    std::vector<Rayf> rays(n);
-    for (int i = 0; i < n; ++i) {
-        rays[i].org = random_point(rng, grown(box, 0.2f));
-        rays[i].dir = random_direction(rng);
-        if (i % 2) rays[i].tfar = u(rng) * diag;
-    }
-    return rays;
-}
+/// random_rays() (tests/oracle_harness.h) draws origins in the scene box
+/// grown by this fraction per side, so that some start outside the structure.
+constexpr float kOriginGrowth = 0.2f;
 
 /// A split plane of the built tree, with the voxel of the node it splits.
 struct SplitPlane {
@@ -378,17 +342,17 @@ TEST_P(KdTree, MatchesBruteForce) {
 
     const std::vector<Rayf> camera = camera_rays(scene, 48);
     expect_agreement(scene, tree, camera, GetParam() + " camera");
-    expect_agreement(scene, tree, random_rays(scene, rng, 1500), GetParam() + " random");
+    expect_agreement(scene, tree, random_rays(scene, rng, 1500, kOriginGrowth), GetParam() + " random");
     expect_agreement(scene, tree, adversarial_rays(tree.tree(), scene, rng), GetParam() + " adversarial");
-    const std::vector<Rayf> shadows = shadow_rays(scene, camera, trace(brute, camera));
+    const std::vector<Rayf> shadows = shadow_rays(scene, camera, trace_hits(brute, camera));
     std::size_t n = 0;
-    const std::vector<std::uint8_t> occ = trace_occluded(tree, shadows);
-    const std::string diff = occlusion_mismatches(shadows, trace_occluded(brute, shadows), occ, n);
+    const std::vector<std::uint8_t> occ = trace_occlusion(tree, shadows);
+    const std::string diff = occlusion_mismatches(shadows, trace_occlusion(brute, shadows), occ, n);
     EXPECT_EQ(n, 0u) << GetParam() << " shadow: " << n << " of " << shadows.size() << " occlusion answers differ"
                      << diff;
     for (int width : {4, 8, 16}) {
         if (!tree.supports_packet(width)) continue;
-        EXPECT_EQ(trace_occluded(tree, shadows, width), occ) << "shadow width " << width;
+        EXPECT_EQ(trace_occlusion(tree, shadows, width), occ) << "shadow width " << width;
     }
 
     // The statistics describe what was built.
@@ -435,7 +399,7 @@ TEST_F(KdTree, OnePrimitiveOfEachKind) {
     for (const Scene& scene : scenes) {
         const auto tree = make_tree(scene);
         EXPECT_EQ(tree->tree().nodes.size(), 1u);  // one primitive: a leaf beats any split
-        std::vector<Rayf> rays = random_rays(scene, rng, 500);
+        std::vector<Rayf> rays = random_rays(scene, rng, 500, kOriginGrowth);
         const std::vector<Rayf> adv = adversarial_rays(tree->tree(), scene, rng);
         rays.insert(rays.end(), adv.begin(), adv.end());
         expect_agreement(scene, *tree, rays, "one " + std::to_string(int(scene.prims[0].kind)));
@@ -493,7 +457,7 @@ TEST_F(KdTree, FlatScenes) {
         // No plane along the flat axis: the root voxel has no thickness there.
         for (const SplitPlane& p : split_planes(tree->tree())) EXPECT_NE(p.axis, axis);
 
-        std::vector<Rayf> rays = random_rays(scene, rng, 1000);
+        std::vector<Rayf> rays = random_rays(scene, rng, 1000, kOriginGrowth);
         const std::vector<Rayf> adv = adversarial_rays(tree->tree(), scene, rng);
         rays.insert(rays.end(), adv.begin(), adv.end());
         std::uniform_real_distribution<float> u(0, 1);
@@ -543,7 +507,7 @@ TEST_F(KdTree, PrimitivesSpanningManyLeaves) {
         for (std::uint32_t k = 0; k < n.prim_count(); ++k) ++leaves_of[p[k]];
     }
     for (std::uint32_t p = 2000; p < 2004; ++p) EXPECT_GT(leaves_of[p], 20u) << p;
-    std::vector<Rayf> rays = random_rays(scene, rng, 3000);
+    std::vector<Rayf> rays = random_rays(scene, rng, 3000, kOriginGrowth);
     const std::vector<Rayf> adv = adversarial_rays(t, scene, rng);
     rays.insert(rays.end(), adv.begin(), adv.end());
     expect_agreement(scene, *tree, rays, "spanning");
@@ -563,8 +527,8 @@ TEST_F(KdTree, PerfectSplitsGiveFewerReferences) {
     boxes_only.perfect_splits = false;
     const auto perfect = make_tree(scene), plain = make_tree(scene, boxes_only);
     EXPECT_LT(perfect->stats().sah_cost, plain->stats().sah_cost);
-    expect_agreement(scene, *perfect, random_rays(scene, rng, 1500), "perfect");
-    expect_agreement(scene, *plain, random_rays(scene, rng, 1500), "boxes only");
+    expect_agreement(scene, *perfect, random_rays(scene, rng, 1500, kOriginGrowth), "perfect");
+    expect_agreement(scene, *plain, random_rays(scene, rng, 1500, kOriginGrowth), "boxes only");
 }
 
 TEST_F(KdTree, ClippedTriangleBoundsAreTight) {
@@ -600,7 +564,7 @@ TEST_F(KdTree, SahTerminatesAndDepthIsLimited) {
     const auto shallow = make_tree(scene, kc);
     EXPECT_LE(shallow->stats().depth, 6);
     std::mt19937 rng(3);
-    expect_agreement(scene, *shallow, random_rays(scene, rng, 500), "depth 6");
+    expect_agreement(scene, *shallow, random_rays(scene, rng, 500, kOriginGrowth), "depth 6");
     // Cheaper intersections relative to traversal: fewer, bigger leaves.
     kc = {};
     kc.intersection_cost = 1;
@@ -662,7 +626,7 @@ TEST_F(KdTree, PacketsWithMixedDirectionsAndRaggedEnds) {
     const Scene scene = load_scene(std::string(RAYPACK_SOURCE_DIR) + "/scenes/gears.nff");
     const auto tree = make_tree(scene);
     std::mt19937 rng(29);
-    std::vector<Rayf> rays = random_rays(scene, rng, 3001);
+    std::vector<Rayf> rays = random_rays(scene, rng, 3001, kOriginGrowth);
     for (std::size_t i = 0; i < rays.size(); i += 7) rays[i].dir.y = (i % 2) ? 0.0f : -0.0f;
     expect_agreement(scene, *tree, rays, "mixed packets");
 }

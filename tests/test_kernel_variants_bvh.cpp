@@ -71,7 +71,7 @@ KernelChoice kernels_of(const Variant& v, TriangleMethod triangle = TriangleMeth
 
 /// Random origins in the grown scene box, random directions, a third with a
 /// finite tfar, a seventh with a +-0 component.
-std::vector<Rayf> random_rays(const Scene& scene, std::mt19937& rng, int n) {
+std::vector<Rayf> random_rays_with_zeros(const Scene& scene, std::mt19937& rng, int n) {
     const Box3f box = grown(scene_bounds(scene), 0.1f);
     std::uniform_real_distribution<float> u(0, 1);
     std::vector<Rayf> rays(static_cast<std::size_t>(n));
@@ -141,54 +141,6 @@ std::vector<std::uint8_t> occluded(const Accel& accel, int width, const std::vec
     return occ;
 }
 
-// ---- Comparisons (as tests/test_wide_bvh.cpp) ----------------------------------------
-
-struct Mismatches {
-    std::size_t count = 0;
-    std::size_t excused = 0;  ///< oracle hits outside their primitive's box (see outside_own_box)
-    std::string first;
-};
-
-bool same_hit(const Hitf& want, const Hitf& got) {
-    if (want.found() != got.found()) return false;
-    if (!want.found()) return true;
-    return want.prim == got.prim ? want.t == got.t
-                                 : std::fabs(want.t - got.t) <= 1e-5f * std::max(std::fabs(want.t), std::fabs(got.t));
-}
-
-Mismatches compare_hits(const Scene& scene, const std::vector<Rayf>& rays, const std::vector<Hitf>& want,
-                        const std::vector<Hitf>& got) {
-    Mismatches m;
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-        if (same_hit(want[i], got[i])) continue;
-        if (want[i].found() && (!got[i].found() || got[i].t > want[i].t) &&
-            outside_own_box(scene, rays[i], want[i].prim, want[i].t)) {
-            ++m.excused;
-            continue;
-        }
-        if (++m.count <= 3)
-            m.first += "\n  ray " + std::to_string(i) + ": " + describe(rays[i]) + "\n    brute " + describe(want[i]) +
-                       ", got " + describe(got[i]);
-    }
-    return m;
-}
-
-Mismatches compare_occluded(const Scene& scene, const KernelChoice& kernels, const std::vector<Rayf>& rays,
-                            const std::vector<std::uint8_t>& want, const std::vector<std::uint8_t>& got) {
-    Mismatches m;
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-        if (want[i] == got[i]) continue;
-        if (want[i] && !hit_inside_own_box(scene, kernels, rays[i])) {
-            ++m.excused;
-            continue;
-        }
-        if (++m.count <= 3)
-            m.first += "\n  ray " + std::to_string(i) + ": " + describe(rays[i]) + "\n    brute " +
-                       (want[i] ? "occluded" : "clear") + ", got " + (got[i] ? "occluded" : "clear");
-    }
-    return m;
-}
-
 bool bits_equal(const Hitf& a, const Hitf& b) {
     auto bits = [](float f) { return std::bit_cast<std::uint32_t>(f); };
     if (a.prim != b.prim || bits(a.t) != bits(b.t)) return false;
@@ -229,7 +181,7 @@ TEST_P(KernelVariantsBvh, AgreeWithOracleAndPacketsEqualSingleRays) {
     ASSERT_GT(scene.primitive_count(), 0u);
     std::mt19937 rng(777);
     const std::vector<Rayf> camera = camera_ray_set(scene, 24, 24);
-    const std::vector<Rayf> random = random_rays(scene, rng, 700);
+    const std::vector<Rayf> random = random_rays_with_zeros(scene, rng, 700);
     const std::vector<Rayf> hard = adversarial_rays(scene, rng, 300);
     const Variant variants[] = {kRobustExactFloat, kRobustExactDouble, kRobustApproxFloat,
                                 kRobustApproxDouble, kPlainExactFloat, kPlainApproxDouble};
@@ -250,16 +202,16 @@ TEST_P(KernelVariantsBvh, AgreeWithOracleAndPacketsEqualSingleRays) {
             const std::vector<Hitf> single = closest(*accel, 1, rays);
             const std::vector<std::uint8_t> single_occ = occluded(*accel, 1, occ_rays);
             if (!plain) {
-                const Mismatches m = compare_hits(scene, rays, truth, single);
+                const Mismatches m = compare_hits(scene, rays, truth, single, 3);
                 EXPECT_EQ(m.count, 0u) << "of " << rays.size() << " rays differ from brute force" << m.first;
-                const Mismatches o = compare_occluded(scene, kc, occ_rays, occ_truth, single_occ);
+                const Mismatches o = compare_occluded(scene, kc, occ_rays, occ_truth, single_occ, 3);
                 EXPECT_EQ(o.count, 0u) << "of " << occ_rays.size() << " occlusion answers differ" << o.first;
             } else {
                 // (c) Plain slabs may lose a box (and so a hit), never invent
                 // one: a hit it reports is the oracle's or a farther one.
                 std::size_t lost = 0;
                 for (std::size_t i = 0; i < rays.size(); ++i) {
-                    if (same_hit(truth[i], single[i])) continue;
+                    if (same_closest_hit(truth[i], single[i])) continue;
                     ++lost;
                     EXPECT_TRUE(truth[i].found() && (!single[i].found() || single[i].t >= truth[i].t))
                         << "ray " << i << ": " << describe(rays[i]) << "\n  brute " << describe(truth[i])
@@ -339,7 +291,7 @@ TEST_P(KernelVariantsBvh, AdversarialRaysRobustLosesNoHit) {
                 const std::vector<std::uint8_t> occ = occluded(*accel, width, rays);
                 std::size_t lost_here = 0;
                 for (std::size_t i = 0; i < rays.size(); ++i) {
-                    if (same_hit(truth[i], got[i]) && occ[i] == occ_truth[i]) continue;
+                    if (same_closest_hit(truth[i], got[i]) && occ[i] == occ_truth[i]) continue;
                     if (++lost_here <= 2 && must_agree)
                         first += "\n  width " + std::to_string(width) + " ray " + std::to_string(i) + ": " +
                                  describe(rays[i]) + "\n    brute " + describe(truth[i]) +

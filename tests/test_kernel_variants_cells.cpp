@@ -42,24 +42,6 @@ namespace {
 
 const char* const kStructures[] = {"grid", "octree", "kdtree"};
 
-std::vector<Hitf> trace(const Accel& accel, const std::vector<Rayf>& rays, int width = 1) {
-    std::vector<Hitf> hits(rays.size());
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 256), [&](const auto& r) {
-        accel.intersect_packets(width, std::span<const Rayf>(rays).subspan(r.begin(), r.size()),
-                                std::span<Hitf>(hits).subspan(r.begin(), r.size()));
-    });
-    return hits;
-}
-
-std::vector<std::uint8_t> trace_occluded(const Accel& accel, const std::vector<Rayf>& rays, int width = 1) {
-    std::vector<std::uint8_t> occ(rays.size());
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 256), [&](const auto& r) {
-        accel.occluded_packets(width, std::span<const Rayf>(rays).subspan(r.begin(), r.size()),
-                               std::span<std::uint8_t>(occ).subspan(r.begin(), r.size()));
-    });
-    return occ;
-}
-
 std::uint32_t bits(float f) { return std::bit_cast<std::uint32_t>(f); }
 
 bool same_bits(const Hitf& a, const Hitf& b) {
@@ -101,26 +83,9 @@ Disagreement compare(const std::vector<Rayf>& rays, const std::vector<Hitf>& wan
     return d;
 }
 
-std::vector<Rayf> camera_rays(const Scene& scene, int size) {
-    const CameraFrame f = make_camera_frame(scene.camera, size, size);
-    std::vector<Rayf> rays;
-    for (int y = 0; y < size; ++y)
-        for (int x = 0; x < size; ++x) rays.push_back(camera_ray(f, float(x) + 0.5f, float(y) + 0.5f));
-    return rays;
-}
-
-std::vector<Rayf> random_rays(const Scene& scene, std::mt19937& rng, int n) {
-    const Box3f box = scene_bounds(scene);
-    const float diag = length(box.extent());
-    std::uniform_real_distribution<float> u(0, 1);
-    std::vector<Rayf> rays(n);
-    for (int i = 0; i < n; ++i) {
-        rays[i].org = random_point(rng, grown(box, 0.2f));
-        rays[i].dir = random_direction(rng);
-        if (i % 2) rays[i].tfar = u(rng) * diag;
-    }
-    return rays;
-}
+/// random_rays() (tests/oracle_harness.h) draws origins in the scene box
+/// grown by this fraction per side, so that some start outside the structure.
+constexpr float kOriginGrowth = 0.2f;
 
 /// The planes a structure computes distances to, per axis, and its root box.
 struct Planes {
@@ -157,78 +122,18 @@ Planes planes_of(const Accel& accel) {
 std::vector<Rayf> adversarial_rays(const Planes& p, const Scene& scene, std::mt19937& rng) {
     std::vector<Rayf> rays;
     const Box3f box = p.root;
-    const float diag = length(box.extent());
     auto plane = [&](int a) { return p.at[a][rng() % p.at[a].size()]; };
     auto corner = [&] { return Vec3f{plane(0), plane(1), plane(2)}; };
-    auto axis_dir = [&](int a, float sign) {
-        Vec3f d{signed_zero(rng), signed_zero(rng), signed_zero(rng)};
-        d[a] = sign;
-        return d;
-    };
     // 1. Along plane intersections, axis-parallel, from outside the root box.
-    for (int i = 0; i < 300; ++i) {
-        const int a = i % 3;
-        const float sign = (i / 3) % 2 ? 1.0f : -1.0f;
-        Rayf r;
-        r.org = corner();
-        r.org[a] = sign > 0 ? box.lo[a] - 0.1f * diag : box.hi[a] + 0.1f * diag;
-        r.dir = axis_dir(a, sign);
-        rays.push_back(r);
-    }
+    append_edge_rays(rays, rng, box, corner, 300);
     // 2. Inside a plane (that direction component +-0), from inside the box.
-    for (int i = 0; i < 300; ++i) {
-        const int a = i % 3;
-        Rayf r;
-        r.org = random_point(rng, box);
-        r.org[a] = plane(a);
-        r.dir = random_direction(rng);
-        r.dir[a] = signed_zero(rng);
-        rays.push_back(r);
-    }
+    append_in_plane_rays(rays, rng, box, plane, 300);
     // 3. Through plane corners, and from them.
-    for (int i = 0; i < 300; ++i) {
-        Rayf r;
-        const Vec3f c = corner();
-        if (i % 3 == 0) {
-            r.org = c;
-            r.dir = random_direction(rng);
-        } else {
-            r.org = random_point(rng, grown(box, 0.5f));
-            r.dir = c - r.org;
-            if (!(dot(r.dir, r.dir) > 0)) r.dir = {1, 1, 1};
-        }
-        rays.push_back(r);
-    }
+    append_corner_rays(rays, rng, box, corner, 300);
     // 4. Origins on the root box's faces: inwards, and along the face (+-0).
-    for (int i = 0; i < 300; ++i) {
-        const int a = i % 3;
-        const bool hi = (i / 3) % 2;
-        Rayf r;
-        r.org = random_point(rng, box);
-        r.org[a] = hi ? box.hi[a] : box.lo[a];
-        r.dir = random_direction(rng);
-        r.dir[a] = i % 4 == 0 ? signed_zero(rng) : (hi ? -1.0f : 1.0f) * std::fabs(r.dir[a]);
-        rays.push_back(r);
-    }
+    append_face_rays(rays, rng, box, 300);
     // 5. Aimed at triangle vertices and sphere poles.
-    const auto n = std::uint32_t(scene.primitive_count());
-    for (int i = 0; i < 200; ++i) {
-        const PrimRef ref = scene.prims[rng() % n];
-        Vec3f target;
-        if (ref.kind == PrimKind::Triangle) {
-            target = scene.triangles.p0[ref.index];
-        } else if (ref.kind == PrimKind::Sphere) {
-            target = scene.spheres.center[ref.index];
-            target[int(rng() % 3)] += scene.spheres.radius[ref.index];
-        } else {
-            target = scene.cones.apex[ref.index];
-        }
-        Rayf r;
-        r.org = random_point(rng, grown(box, 0.2f));
-        r.dir = target - r.org;
-        if (!(dot(r.dir, r.dir) > 0)) r.dir = {0, 0, 1};
-        rays.push_back(r);
-    }
+    append_vertex_rays(rays, scene, rng, grown(box, 0.2f), 200);
     return rays;
 }
 
@@ -287,16 +192,16 @@ TEST_P(KernelVariantsCells, RobustVariantsAgreeWithOracle) {
     const Scene scene = load(GetParam());
     std::mt19937 rng(3);
     std::vector<Rayf> rays = camera_rays(scene, 24);
-    const std::vector<Rayf> random = random_rays(scene, rng, 600);
+    const std::vector<Rayf> random = random_rays(scene, rng, 600, kOriginGrowth);
     rays.insert(rays.end(), random.begin(), random.end());
     for (const KernelChoice& k : {variant(SlabMethod::Robust, RcpMethod::Exact, Precision::Float),
                                   variant(SlabMethod::Robust, RcpMethod::Exact, Precision::Double),
                                   variant(SlabMethod::Robust, RcpMethod::Approx, Precision::Float)}) {
         const BruteForce oracle(scene, k);
-        const std::vector<Hitf> want = trace(oracle, rays);
+        const std::vector<Hitf> want = trace_hits(oracle, rays);
         for (const char* kind : kStructures) {
             const std::unique_ptr<Accel> accel = build_accel(scene, accel_config(kind, k));
-            const Disagreement d = compare(rays, want, trace(*accel, rays), trace_occluded(*accel, rays));
+            const Disagreement d = compare(rays, want, trace_hits(*accel, rays), trace_occlusion(*accel, rays));
             EXPECT_EQ(d.total(), 0u) << GetParam() << " " << kind << " " << name(k) << ": " << d.lost << " lost, "
                                      << d.farther << " farther, " << d.extra << " extra of " << rays.size()
                                      << d.first;
@@ -317,19 +222,19 @@ TEST_P(KernelVariantsCells, PacketsAndCountingEqualSingleRays) {
                                       variant(SlabMethod::Plain, RcpMethod::Approx, Precision::Float)}) {
             const std::unique_ptr<Accel> accel = make(scene, kind, k);
             std::vector<Rayf> rays = camera_rays(scene, 16);
-            const std::vector<Rayf> random = random_rays(scene, rng, 200);
+            const std::vector<Rayf> random = random_rays(scene, rng, 200, kOriginGrowth);
             const std::vector<Rayf> adv = adversarial_rays(planes_of(*accel), scene, rng);
             rays.insert(rays.end(), random.begin(), random.end());
             rays.insert(rays.end(), adv.begin(), adv.end());
             rays.resize(rays.size() - 3);  // a ragged last packet
-            const std::vector<Hitf> want = trace(*accel, rays);
-            const std::vector<std::uint8_t> want_occ = trace_occluded(*accel, rays);
+            const std::vector<Hitf> want = trace_hits(*accel, rays);
+            const std::vector<std::uint8_t> want_occ = trace_occlusion(*accel, rays);
             int checked = 0;
             for (int width : {4, 8, 16}) {
                 if (!accel->supports_packet(width)) continue;
                 ++checked;
-                const std::vector<Hitf> got = trace(*accel, rays, width);
-                const std::vector<std::uint8_t> got_occ = trace_occluded(*accel, rays, width);
+                const std::vector<Hitf> got = trace_hits(*accel, rays, width);
+                const std::vector<std::uint8_t> got_occ = trace_occlusion(*accel, rays, width);
                 std::size_t differ = 0;
                 for (std::size_t i = 0; i < rays.size(); ++i) {
                     if (same_bits(want[i], got[i]) && want_occ[i] == got_occ[i]) continue;
@@ -362,24 +267,24 @@ TEST_P(KernelVariantsCells, PlainSlabsLoseOnlyTheStatedHits) {
     const Scene scene = load(GetParam());
     std::mt19937 rng(3);
     std::vector<Rayf> rays = camera_rays(scene, 24);
-    const std::vector<Rayf> random = random_rays(scene, rng, 600);
+    const std::vector<Rayf> random = random_rays(scene, rng, 600, kOriginGrowth);
     rays.insert(rays.end(), random.begin(), random.end());
     const KernelChoice plain = variant(SlabMethod::Plain, RcpMethod::Exact, Precision::Float);
     const KernelChoice plain_approx = variant(SlabMethod::Plain, RcpMethod::Approx, Precision::Float);
     const BruteForce oracle(scene, plain);
-    const std::vector<Hitf> want = trace(oracle, rays);
+    const std::vector<Hitf> want = trace_hits(oracle, rays);
     for (int s = 0; s < 3; ++s) {
         const char* kind = kStructures[s];
         for (const KernelChoice& k : {plain, plain_approx}) {
             const std::unique_ptr<Accel> accel = build_accel(scene, accel_config(kind, k));
-            const Disagreement d = compare(rays, want, trace(*accel, rays), trace_occluded(*accel, rays));
+            const Disagreement d = compare(rays, want, trace_hits(*accel, rays), trace_occlusion(*accel, rays));
             EXPECT_EQ(d.total(), 0u) << GetParam() << " " << kind << " " << name(k) << " random: " << d.lost
                                      << " lost, " << d.farther << " farther, " << d.extra << " extra" << d.first;
 
             std::mt19937 adv_rng(7);
             const std::vector<Rayf> adv = adversarial_rays(planes_of(*accel), scene, adv_rng);
-            const std::vector<Hitf> adv_want = trace(oracle, adv);
-            const Disagreement a = compare(adv, adv_want, trace(*accel, adv), trace_occluded(*accel, adv));
+            const std::vector<Hitf> adv_want = trace_hits(oracle, adv);
+            const Disagreement a = compare(adv, adv_want, trace_hits(*accel, adv), trace_occlusion(*accel, adv));
             EXPECT_EQ(a.extra, 0u) << GetParam() << " " << kind << " " << name(k) << a.first;
             const std::string key = std::string(kind) + " " + name(k);
             RecordProperty(key + " adversarial lost", std::to_string(a.lost + a.farther));
@@ -406,7 +311,7 @@ TEST_P(KernelVariantsCells, RobustWatertightLosesNoAdversarialHit) {
         const std::unique_ptr<Accel> accel = build_accel(scene, accel_config(kind, k));
         std::mt19937 rng(7);
         const std::vector<Rayf> adv = adversarial_rays(planes_of(*accel), scene, rng);
-        const Disagreement d = compare(adv, trace(oracle, adv), trace(*accel, adv), trace_occluded(*accel, adv));
+        const Disagreement d = compare(adv, trace_hits(oracle, adv), trace_hits(*accel, adv), trace_occlusion(*accel, adv));
         EXPECT_EQ(d.total(), 0u) << GetParam() << " " << kind << ": " << d.lost << " lost, " << d.farther
                                  << " farther, " << d.extra << " extra of " << adv.size() << d.first;
     }

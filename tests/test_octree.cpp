@@ -127,7 +127,13 @@ void expect_agreement(const Scene& scene, const Accel& octree, const std::vector
 
 // ---- Ray sets -----------------------------------------------------------------------
 
-std::vector<Rayf> camera_rays(const Scene& scene, int size) {
+/// random_rays() (tests/oracle_harness.h) draws origins in the scene box
+/// grown by this fraction per side, so that some start outside the structure.
+constexpr float kOriginGrowth = 0.2f;
+
+/// As camera_rays() (tests/oracle_harness.h), in another order: 4x4 pixel
+/// tiles one after the other.
+std::vector<Rayf> tiled_camera_rays(const Scene& scene, int size) {
     const CameraFrame f = make_camera_frame(scene.camera, size, size);
     std::vector<Rayf> rays;
     // 4x4 tiles, so that packets of 16 are square.
@@ -136,19 +142,6 @@ std::vector<Rayf> camera_rays(const Scene& scene, int size) {
             for (int y = ty; y < std::min(size, ty + 4); ++y)
                 for (int x = tx; x < std::min(size, tx + 4); ++x)
                     rays.push_back(camera_ray(f, float(x) + 0.5f, float(y) + 0.5f));
-    return rays;
-}
-
-std::vector<Rayf> random_rays(const Scene& scene, std::mt19937& rng, int n) {
-    const Box3f box = scene_bounds(scene);
-    const float diag = length(box.extent());
-    std::uniform_real_distribution<float> u(0, 1);
-    std::vector<Rayf> rays(n);
-    for (int i = 0; i < n; ++i) {
-        rays[i].org = random_point(rng, grown(box, 0.2f));
-        rays[i].dir = random_direction(rng);
-        if (i % 2) rays[i].tfar = u(rng) * diag;
-    }
     return rays;
 }
 
@@ -167,36 +160,15 @@ std::vector<Rayf> octree_adversarial_rays(const Octree& tree, const Scene& scene
         return box.lo[axis] + (box.hi[axis] - box.lo[axis]) * (float(k) / float(1 << d));
     };
     auto corner = [&] { return Vec3f{plane(0), plane(1), plane(2)}; };
-    auto axis_dir = [&](int axis, float sign) {
-        Vec3f d{signed_zero(rng), signed_zero(rng), signed_zero(rng)};
-        d[axis] = sign;
-        return d;
-    };
     // 1. Along node edges: the two other coordinates on node planes, axis-parallel, from outside.
-    for (int i = 0; i < 600; ++i) {
-        const int a = i % 3;
-        const float sign = (i / 3) % 2 ? 1.0f : -1.0f;
-        Rayf r;
-        r.org = corner();
-        r.org[a] = sign > 0 ? box.lo[a] - 0.1f * diag : box.hi[a] + 0.1f * diag;
-        r.dir = axis_dir(a, sign);
-        rays.push_back(r);
-    }
+    append_edge_rays(rays, rng, box, corner, 600);
     // 2. Inside a node plane (that direction component +-0), from inside the cube.
-    for (int i = 0; i < 600; ++i) {
-        const int a = i % 3;
-        Rayf r;
-        r.org = random_point(rng, box);
-        r.org[a] = plane(a);
-        r.dir = random_direction(rng);
-        r.dir[a] = signed_zero(rng);
-        rays.push_back(r);
-    }
+    append_in_plane_rays(rays, rng, box, plane, 600);
     // 3. Axis-parallel from random origins in and around the cube; half with a finite tfar.
     for (int i = 0; i < 600; ++i) {
         Rayf r;
         r.org = random_point(rng, grown(box, 0.1f));
-        r.dir = axis_dir(i % 3, (i / 3) % 2 ? 1.0f : -1.0f);
+        r.dir = axis_direction(rng, i % 3, (i / 3) % 2 ? 1.0f : -1.0f);
         if (i % 2) r.tfar = u(rng) * diag;
         rays.push_back(r);
     }
@@ -219,19 +191,7 @@ std::vector<Rayf> octree_adversarial_rays(const Octree& tree, const Scene& scene
         rays.push_back(r);
     }
     // 6. Through node corners, and from node corners.
-    for (int i = 0; i < 900; ++i) {
-        Rayf r;
-        const Vec3f c = corner();
-        if (i % 3 == 0) {
-            r.org = c;
-            r.dir = random_direction(rng);
-        } else {
-            r.org = random_point(rng, grown(box, 0.5f));
-            r.dir = c - r.org;
-            if (!(dot(r.dir, r.dir) > 0)) r.dir = {1, 1, 1};
-        }
-        rays.push_back(r);
-    }
+    append_corner_rays(rays, rng, box, corner, 900);
     // 7. Along node diagonals: ties between all three axes at every midplane.
     for (int i = 0; i < 300; ++i) {
         Rayf r;
@@ -252,24 +212,7 @@ std::vector<Rayf> octree_adversarial_rays(const Octree& tree, const Scene& scene
         rays.push_back(r);
     }
     // 9. Aimed at triangle vertices and sphere poles.
-    const auto nprims = std::uint32_t(scene.primitive_count());
-    for (int i = 0; i < 300 && nprims; ++i) {
-        const PrimRef ref = scene.prims[rng() % nprims];
-        Vec3f target;
-        if (ref.kind == PrimKind::Triangle) {
-            target = scene.triangles.p0[ref.index];
-        } else if (ref.kind == PrimKind::Sphere) {
-            target = scene.spheres.center[ref.index];
-            target[int(rng() % 3)] += scene.spheres.radius[ref.index];
-        } else {
-            target = scene.cones.apex[ref.index];
-        }
-        Rayf r;
-        r.org = random_point(rng, grown(box, 0.2f));
-        r.dir = target - r.org;
-        if (!(dot(r.dir, r.dir) > 0)) r.dir = {0, 0, 1};
-        rays.push_back(r);
-    }
+    append_vertex_rays(rays, scene, rng, grown(box, 0.2f), 300);
     return rays;
 }
 
@@ -355,9 +298,9 @@ TEST_P(Octree, MatchesBruteForce) {
     std::mt19937 rng(20240605);
     const BruteForce brute(scene, KernelChoice{});
 
-    const std::vector<Rayf> camera = camera_rays(scene, 64);
+    const std::vector<Rayf> camera = tiled_camera_rays(scene, 64);
     expect_agreement(scene, octree, camera, GetParam() + " camera");
-    expect_agreement(scene, octree, random_rays(scene, rng, 2000), GetParam() + " random");
+    expect_agreement(scene, octree, random_rays(scene, rng, 2000, kOriginGrowth), GetParam() + " random");
     expect_agreement(scene, octree, octree_adversarial_rays(octree.octree(), scene, rng), GetParam() + " adversarial");
     const std::vector<Rayf> shadows = shadow_rays(scene, camera, trace(brute, camera));
     const std::vector<std::uint8_t> want = trace_occluded(brute, shadows);
@@ -427,7 +370,7 @@ TEST_F(Octree, OnePrimitiveOfEachKind) {
     for (const Scene& scene : scenes) {
         const auto octree = make_octree(scene);
         EXPECT_EQ(octree->stats().nodes, 1u);
-        std::vector<Rayf> rays = random_rays(scene, rng, 500);
+        std::vector<Rayf> rays = random_rays(scene, rng, 500, kOriginGrowth);
         const std::vector<Rayf> adv = octree_adversarial_rays(octree->octree(), scene, rng);
         rays.insert(rays.end(), adv.begin(), adv.end());
         expect_agreement(scene, *octree, rays, "one " + std::to_string(int(scene.prims[0].kind)));
@@ -483,7 +426,7 @@ TEST_F(Octree, FlatScenes) {
         // The plane lies in the cube's midplane along `axis`: it is split
         // anyway, and both halves hold the whole plane only where it matters.
         EXPECT_GT(octree->stats().depth, 2);
-        std::vector<Rayf> rays = random_rays(scene, rng, 1000);
+        std::vector<Rayf> rays = random_rays(scene, rng, 1000, kOriginGrowth);
         const std::vector<Rayf> adv = octree_adversarial_rays(octree->octree(), scene, rng);
         rays.insert(rays.end(), adv.begin(), adv.end());
         std::uniform_real_distribution<float> u(0, 1);
@@ -523,7 +466,7 @@ TEST_F(Octree, PrimitivesSpanningManyNodes) {
     std::vector<std::size_t> leaves_of(scene.primitive_count(), 0);
     for (std::uint32_t p : octree->octree().refs) ++leaves_of[p];
     for (std::uint32_t p = 2000; p < 2004; ++p) EXPECT_GT(leaves_of[p], 20u) << p;
-    std::vector<Rayf> rays = random_rays(scene, rng, 3000);
+    std::vector<Rayf> rays = random_rays(scene, rng, 3000, kOriginGrowth);
     const std::vector<Rayf> adv = octree_adversarial_rays(octree->octree(), scene, rng);
     rays.insert(rays.end(), adv.begin(), adv.end());
     expect_agreement(scene, *octree, rays, "spanning");
@@ -547,14 +490,14 @@ TEST_F(Octree, UnsplittableNodesStayLeaves) {
     expect_well_formed(*octree, scene, oc);
     EXPECT_EQ(octree->stats().nodes, 1u);
     std::mt19937 rng(5);
-    expect_agreement(scene, *octree, random_rays(scene, rng, 1000), "fan");
+    expect_agreement(scene, *octree, random_rays(scene, rng, 1000, kOriginGrowth), "fan");
 }
 
 TEST_F(Octree, ConfigurationsAgree) {
     // Leaf size, depth and placement change the tree, never the answers.
     const Scene scene = load_scene(std::string(RAYPACK_SOURCE_DIR) + "/scenes/tetra.nff");
     std::mt19937 rng(3);
-    const std::vector<Rayf> rays = random_rays(scene, rng, 2000);
+    const std::vector<Rayf> rays = random_rays(scene, rng, 2000, kOriginGrowth);
     for (int leaf : {1, 4, 32}) {
         for (int depth : {0, 3, 16}) {
             for (bool exact : {true, false}) {
@@ -630,7 +573,7 @@ TEST_F(Octree, LeavesHoldTheTrianglesThatMeetThem) {
 TEST_F(Octree, CountingModeAgreesAndCounts) {
     const Scene scene = load_scene(std::string(RAYPACK_SOURCE_DIR) + "/scenes/teapot.nff");
     const auto octree = make_octree(scene);
-    const std::vector<Rayf> rays = camera_rays(scene, 32);
+    const std::vector<Rayf> rays = tiled_camera_rays(scene, 32);
     OctreeRayCounters c;
     for (const Rayf& r : rays) {
         const Hitf want = octree->intersect1(r);

@@ -64,27 +64,6 @@ std::vector<std::uint8_t> trace_occluded(const Accel& accel, const std::vector<R
 
 // ---- Ray sets ------------------------------------------------------------------
 
-std::vector<Rayf> camera_rays(const Scene& scene, int size) {
-    const CameraFrame f = make_camera_frame(scene.camera, size, size);
-    std::vector<Rayf> rays;
-    for (int y = 0; y < size; ++y)
-        for (int x = 0; x < size; ++x) rays.push_back(camera_ray(f, float(x) + 0.5f, float(y) + 0.5f));
-    return rays;
-}
-
-std::vector<Rayf> random_rays(const Scene& scene, std::mt19937& rng, int n) {
-    const Box3f box = scene_bounds(scene);
-    const float diag = length(box.extent());
-    std::uniform_real_distribution<float> u(0, 1);
-    std::vector<Rayf> rays(n);
-    for (int i = 0; i < n; ++i) {
-        rays[i].org = random_point(rng, box);
-        rays[i].dir = random_direction(rng);
-        if (i % 2) rays[i].tfar = u(rng) * diag;
-    }
-    return rays;
-}
-
 /// A point of primitive p on its bounding box: a vertex, the top of a
 /// sphere, the centre of a cone end.
 Vec3f extreme_point(const Scene& s, std::uint32_t p, std::mt19937& rng) {
@@ -184,53 +163,6 @@ std::vector<Rayf> adversarial_rays(const Scene& scene, const std::vector<Box3f>&
         rays.push_back(r);
     }
     return rays;
-}
-
-// ---- Comparisons -----------------------------------------------------------------
-
-struct Mismatches {
-    std::size_t count = 0;
-    std::size_t excused = 0;  ///< oracle hits outside their primitive's box (see outside_own_box)
-    std::string first;        ///< the first few, with reproducing rays
-};
-
-Mismatches compare_hits(const Scene& scene, const std::vector<Rayf>& rays, const std::vector<Hitf>& want,
-                        const std::vector<Hitf>& got) {
-    Mismatches m;
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-        bool ok = want[i].found() == got[i].found();
-        if (ok && want[i].found())
-            ok = want[i].prim == got[i].prim
-                     ? want[i].t == got[i].t
-                     : std::fabs(want[i].t - got[i].t) <= 1e-5f * std::max(std::fabs(want[i].t), std::fabs(got[i].t));
-        if (ok) continue;
-        // Missed the oracle's (nearer) hit: excused if that hit is outside its box.
-        if (want[i].found() && (!got[i].found() || got[i].t > want[i].t) &&
-            outside_own_box(scene, rays[i], want[i].prim, want[i].t)) {
-            ++m.excused;
-            continue;
-        }
-        if (++m.count <= 5)
-            m.first += "\n  ray " + std::to_string(i) + ": " + describe(rays[i]) + "\n    brute " + describe(want[i]) +
-                       ", got " + describe(got[i]);
-    }
-    return m;
-}
-
-Mismatches compare_occluded(const Scene& scene, const KernelChoice& kernels, const std::vector<Rayf>& rays,
-                            const std::vector<std::uint8_t>& want, const std::vector<std::uint8_t>& got) {
-    Mismatches m;
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-        if (want[i] == got[i]) continue;
-        if (want[i] && !hit_inside_own_box(scene, kernels, rays[i])) {
-            ++m.excused;
-            continue;
-        }
-        if (++m.count <= 5)
-            m.first += "\n  ray " + std::to_string(i) + ": " + describe(rays[i]) + "\n    brute " +
-                       (want[i] ? "occluded" : "clear") + ", got " + (got[i] ? "occluded" : "clear");
-    }
-    return m;
 }
 
 // ---- Structure ---------------------------------------------------------------------
@@ -420,13 +352,13 @@ void check_against_oracle(const Scene& scene, const KernelChoice& kernels, int c
         check_any_structure(accel, scene);
         std::size_t excused = 0;
         for (std::size_t k = 0; k < sets.size(); ++k) {
-            const Mismatches m = compare_hits(scene, sets[k].rays, truth[k], trace(accel, sets[k].rays));
+            const Mismatches m = compare_hits(scene, sets[k].rays, truth[k], trace(accel, sets[k].rays), 5);
             EXPECT_EQ(m.count, 0u) << sets[k].name << ": " << m.count << " of " << sets[k].rays.size()
                                    << " rays differ from brute force" << m.first;
             excused += m.excused;
         }
         const Mismatches m =
-            compare_occluded(scene, kernels, occlusion, occlusion_truth, trace_occluded(accel, occlusion));
+            compare_occluded(scene, kernels, occlusion, occlusion_truth, trace_occluded(accel, occlusion), 5);
         EXPECT_EQ(m.count, 0u) << "occlusion: " << m.count << " of " << occlusion.size() << " answers differ"
                                << m.first;
         excused += m.excused;
