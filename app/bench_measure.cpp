@@ -96,12 +96,12 @@ BenchRays load_bench_rays(const std::string& path) {
     return {"file:" + std::filesystem::path(path).stem().string(), file.kind == RayKind::AnyHit, std::move(file.rays)};
 }
 
-OracleSample oracle_sample(const Scene& scene, const BenchRays& set, std::size_t max_rays) {
+OracleSample oracle_sample(const Scene& scene, const BenchRays& set, std::size_t max_rays, KernelChoice kernels) {
     OracleSample s;
     s.index = sample_positions(set.rays.size(), max_rays, kSampleBlock);
     s.rays = gather(set.rays, s.index);
     s.expected.resize(s.rays.size());
-    const auto oracle = build_accel(scene, accel_config("brute"));
+    const auto oracle = build_accel(scene, accel_config("brute", kernels));
     trace_all(*oracle, 1, set.any_hit, s.rays, s.expected, 16);
     return s;
 }

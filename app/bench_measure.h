@@ -33,7 +33,10 @@ struct OracleSample {
     std::vector<Rayf> rays;
     std::vector<Hitf> expected;      ///< brute force (any hit: found() = occluded)
 };
-OracleSample oracle_sample(const Scene& scene, const BenchRays& set, std::size_t max_rays);
+/// Brute force with the primitive tests and precision of `kernels` (it has
+/// no boxes, so slabs and reciprocals do not apply): a structure is checked
+/// for finding what its own tests find, not for the tests' rounding.
+OracleSample oracle_sample(const Scene& scene, const BenchRays& set, std::size_t max_rays, KernelChoice kernels = {});
 
 /// Traces the sample as the timed loop does (packets of `packet`) and
 /// compares: hit or miss identical, t within relative 1e-5, occlusion

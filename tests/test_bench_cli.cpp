@@ -132,5 +132,32 @@ TEST(BenchCli, RaysFileIsTracedAndValidated) {
     for (const auto& row : rows) EXPECT_EQ(row["rays"], "file:camera");
 }
 
+/// The kernel variants and --builder reach the structures (the builder shows
+/// in the rows) and the oracle: with watertight triangles in double, every
+/// structure must still find what brute force with those tests finds, and
+/// Embree, which runs its own tests, what the default oracle finds.
+TEST(BenchCli, KernelVariantsAndBuilderReachStructuresAndOracle) {
+    std::string accels = "bvh2,bvh8,kdtree";
+    for (const char* k : accel_kinds())
+        if (std::string(k) == "embree") accels += ",embree";
+    const fs::path json = temp_dir() / "variants.json";
+    const BenchRun r = run_bench("gen:tetra:3 --quick --rays camera,shadow --accel " + accels +
+                                 " --triangle watertight --precision double --builder sweep --json " + json.string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("kernels: watertight triangles, geometric spheres, robust slabs, exact rcp, double; "
+                            "builder sweep"),
+              std::string::npos)
+        << r.output;
+    std::ifstream in(json);
+    const nlohmann::json rows = nlohmann::json::parse(in);
+    int bvh_rows = 0;
+    for (const auto& row : rows)
+        if (row["accel"] == "bvh2" || row["accel"] == "bvh8") {
+            EXPECT_EQ(row["builder"], "sweep") << row.dump();
+            ++bvh_rows;
+        }
+    EXPECT_GT(bvh_rows, 0);
+}
+
 }  // namespace
 }  // namespace raypack
