@@ -107,31 +107,26 @@ bool GridAccel::trace(Rayf& ray, Hitf& hit, GridRayCounters* counters) const {
     return found;
 }
 
-// The slab form is chosen once per batch, so that each loop inlines one
-// instance of the walk (choosing it per ray cost the octree 25%).
+// The slab form is chosen once per batch (with_slab_form).
 void GridAccel::intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const {
-    auto run = [&]<SlabMethod Slabs>(SlabTag<Slabs>) {
+    with_slab_form(kernels_.slabs, [&]<SlabMethod Slabs>(SlabTag<Slabs>) {
         for (std::size_t i = 0; i < rays.size(); ++i) {
             Rayf ray = rays[i];
             Hitf hit;
             trace_with<false, false, Slabs>(ray, hit, nullptr);
             hits[i] = hit;
         }
-    };
-    if (kernels_.slabs == SlabMethod::Plain) run(SlabTag<SlabMethod::Plain>{});
-    else run(SlabTag<SlabMethod::Robust>{});
+    });
 }
 
 void GridAccel::occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const {
-    auto run = [&]<SlabMethod Slabs>(SlabTag<Slabs>) {
+    with_slab_form(kernels_.slabs, [&]<SlabMethod Slabs>(SlabTag<Slabs>) {
         for (std::size_t i = 0; i < rays.size(); ++i) {
             Rayf ray = rays[i];
             Hitf hit;
             occluded[i] = trace_with<true, false, Slabs>(ray, hit, nullptr) ? 1 : 0;
         }
-    };
-    if (kernels_.slabs == SlabMethod::Plain) run(SlabTag<SlabMethod::Plain>{});
-    else run(SlabTag<SlabMethod::Robust>{});
+    });
 }
 
 Hitf GridAccel::intersect_counting(const Rayf& ray_in, GridRayCounters& counters) const {

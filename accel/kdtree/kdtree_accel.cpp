@@ -162,31 +162,26 @@ bool KdTreeAccel::trace(Rayf& ray, Hitf& hit, KdRayCounters* counters) const {
     }
 }
 
-// The slab form is chosen once per batch, so that each loop inlines one
-// instance of the walk (choosing it per ray cost the octree 25%).
+// The slab form is chosen once per batch (with_slab_form).
 void KdTreeAccel::intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const {
-    auto run = [&]<SlabMethod Slabs>(SlabTag<Slabs>) {
+    with_slab_form(kernels_.slabs, [&]<SlabMethod Slabs>(SlabTag<Slabs>) {
         for (std::size_t i = 0; i < rays.size(); ++i) {
             Rayf ray = rays[i];
             Hitf hit;
             trace<false, false, Slabs>(ray, hit, nullptr);
             hits[i] = hit;
         }
-    };
-    if (kernels_.slabs == SlabMethod::Plain) run(SlabTag<SlabMethod::Plain>{});
-    else run(SlabTag<SlabMethod::Robust>{});
+    });
 }
 
 void KdTreeAccel::occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const {
-    auto run = [&]<SlabMethod Slabs>(SlabTag<Slabs>) {
+    with_slab_form(kernels_.slabs, [&]<SlabMethod Slabs>(SlabTag<Slabs>) {
         for (std::size_t i = 0; i < rays.size(); ++i) {
             Rayf ray = rays[i];
             Hitf hit;
             occluded[i] = trace<true, false, Slabs>(ray, hit, nullptr) ? 1 : 0;
         }
-    };
-    if (kernels_.slabs == SlabMethod::Plain) run(SlabTag<SlabMethod::Plain>{});
-    else run(SlabTag<SlabMethod::Robust>{});
+    });
 }
 
 Hitf KdTreeAccel::intersect_counting(const Rayf& ray_in, KdRayCounters& counters) const {

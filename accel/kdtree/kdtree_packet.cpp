@@ -157,15 +157,13 @@ void kdtree_trace_packets(const KdTree& tree, const Scene& scene, KernelChoice k
     using F = vfloat<K>;
     const PacketPrimitiveIntersector<F> isect{&scene, kernels};
     // The slab form is chosen once for all packets, rdir once per packet.
-    auto run = [&]<SlabMethod Slabs>(SlabTag<Slabs>) {
+    with_slab_form(kernels.slabs, [&]<SlabMethod Slabs>(SlabTag<Slabs>) {
         trace_in_packets<K, AnyHit>(rays, hits, kernels.rcp, [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid,
                                                     vmask<K>& occluded) {
             if (tree.empty()) return;
             trace_packet<K, AnyHit, Slabs>(tree, isect, ray, hit, valid, occluded);
         });
-    };
-    if (kernels.slabs == SlabMethod::Plain) run(SlabTag<SlabMethod::Plain>{});
-    else run(SlabTag<SlabMethod::Robust>{});
+    });
 }
 
 #if defined(__SSE4_2__)
