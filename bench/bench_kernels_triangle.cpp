@@ -1,7 +1,9 @@
 // Ray-triangle microbenchmarks: triangle/VARIANT/K (K rays against one
 // triangle) and triangle_1xM/VARIANT/M (one ray against a block of M
-// triangles in SoA). Every hit's t, u, v are kept (selected into running
-// values), as a closest-hit loop would, so no output is dead code.
+// triangles in SoA). Every hit is kept (selected into running values), as a
+// closest-hit loop would, so no output is dead code: t, u, v, or for Moeller
+// t and the undivided U, V with 1/det, multiplied into u, v once at the end
+// (kernels/triangle.h, MoellerUV). Every width runs the same loop.
 #include <bit>
 
 #include "bench/kernel_bench.h"
@@ -38,46 +40,66 @@ PreparedRay<M, F> prepare(const RayLanes<F>& r) {
     else return {r.org, r.dir, r.tnear, r.tfar};
 }
 
+/// What the closest-hit loop keeps of a test: t with u, v, or with
+/// Moeller's deferred MoellerUV.
+template <TriangleMethod M, class F>
+struct KeptHit {
+    F t = F(0.0f), u = F(0.0f), v = F(0.0f);
+    RAYPACK_INLINE F final_u() const { return u; }
+    RAYPACK_INLINE F final_v() const { return v; }
+    /// Each hit lane overwrites its running values (which consumes the mask too).
+    RAYPACK_INLINE void keep(const mask_of<F>& m, const KeptHit& h) {
+        t = select(m, h.t, t);
+        u = select(m, h.u, u);
+        v = select(m, h.v, v);
+    }
+};
+template <class F>
+struct KeptHit<TriangleMethod::Moeller, F> {
+    F t = F(0.0f);
+    MoellerUV<F> uv{F(0.0f), F(0.0f), F(0.0f)};
+    RAYPACK_INLINE F final_u() const { return uv.u(); }
+    RAYPACK_INLINE F final_v() const { return uv.v(); }
+    RAYPACK_INLINE void keep(const mask_of<F>& m, const KeptHit& h) {
+        t = select(m, h.t, t);
+        uv.U = select(m, h.uv.U, uv.U);
+        uv.V = select(m, h.uv.V, uv.V);
+        uv.inv_det = select(m, h.uv.inv_det, uv.inv_det);
+    }
+};
+
 template <TriangleMethod M, class F>
 RAYPACK_INLINE mask_of<F> tri_test(const PreparedRay<M, F>& r, const Vec3<F>& p0, const Vec3<F>& p1,
-                                   const Vec3<F>& p2, F& t, F& u, F& v) {
+                                   const Vec3<F>& p2, KeptHit<M, F>& h) {
     const mask_of<F> all(true);
     if constexpr (M == TriangleMethod::Moeller)
-        return intersect_triangle_moeller<F>(all, r.org, r.dir, r.tnear, r.tfar, p0, p1, p2, t, u, v);
+        return intersect_triangle_moeller<F>(all, r.org, r.dir, r.tnear, r.tfar, p0, p1, p2, h.t, h.uv);
     else if constexpr (M == TriangleMethod::Watertight)
-        return intersect_triangle_watertight<F>(all, r.ray, r.tnear, r.tfar, p0, p1, p2, t, u, v);
+        return intersect_triangle_watertight<F>(all, r.ray, r.tnear, r.tfar, p0, p1, p2, h.t, h.u, h.v);
     else
-        return intersect_triangle_plane<F>(all, r.org, r.dir, r.tnear, r.tfar, p0, p1, p2, t, u, v);
+        return intersect_triangle_plane<F>(all, r.org, r.dir, r.tnear, r.tfar, p0, p1, p2, h.t, h.u, h.v);
 }
 
-/// Running closest-hit-like state: each hit overwrites its lane of t, u, v
-/// (which consumes the hit mask too). Plain locals, so that they stay in
-/// registers through the loop.
-template <class F>
-RAYPACK_INLINE void keep(const mask_of<F>& m, const F& t, const F& u, const F& v, F& kt, F& ku, F& kv) {
-    kt = select(m, t, kt);
-    ku = select(m, u, ku);
-    kv = select(m, v, kv);
-}
-
-/// Publishes copies: DoNotOptimize on the running values themselves would
-/// give them a home in memory, stored to on every iteration.
-template <class F>
-RAYPACK_INLINE void publish(F kt, F ku, F kv) {
-    benchmark::DoNotOptimize(kt);
-    benchmark::DoNotOptimize(ku);
-    benchmark::DoNotOptimize(kv);
+/// Publishes the final t, u, v of the running hits: DoNotOptimize on the
+/// running values themselves would give them a home in memory, stored to
+/// on every iteration.
+template <TriangleMethod M, class F>
+RAYPACK_INLINE void publish(const KeptHit<M, F>& h) {
+    F t = h.t, u = h.final_u(), v = h.final_v();
+    benchmark::DoNotOptimize(t);
+    benchmark::DoNotOptimize(u);
+    benchmark::DoNotOptimize(v);
 }
 
 bool same_bits(float a, float b) { return std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b); }
 
 /// Lane l of a packet answer equals the width-1 answer: the same hit, and on
 /// a hit the same t, u, v bit for bit.
-template <class F>
-bool lane_matches(const mask_of<F>& m, const F& t, const F& u, const F& v, int l, bool hit1, float t1, float u1,
-                  float v1) {
+template <TriangleMethod M, class F>
+bool lane_matches(const mask_of<F>& m, const KeptHit<M, F>& h, int l, bool hit1, const KeptHit<M, float>& h1) {
     if (lane(m, l) != hit1) return false;
-    return !hit1 || (same_bits(lane(t, l), t1) && same_bits(lane(u, l), u1) && same_bits(lane(v, l), v1));
+    return !hit1 || (same_bits(lane(h.t, l), h1.t) && same_bits(lane(h.final_u(), l), h1.final_u()) &&
+                     same_bits(lane(h.final_v(), l), h1.final_v()));
 }
 
 template <TriangleMethod M, int K>
@@ -92,26 +114,25 @@ void triangle_packet(benchmark::State& state) {
     std::size_t hits = 0;
     bool same = true;
     for (std::size_t i = 0; i < rays.n; i += K) {
-        F t(0.0f), u(0.0f), v(0.0f);
-        const mask_of<F> m = tri_test<M, F>(packets[i / K], p0, p1, p2, t, u, v);
+        KeptHit<M, F> h;
+        const mask_of<F> m = tri_test<M, F>(packets[i / K], p0, p1, p2, h);
         for (int l = 0; l < K; ++l) {
-            float t1 = 0, u1 = 0, v1 = 0;
-            const bool h = tri_test<M, float>(prepare<M>(load_rays<float>(rays, i + std::size_t(l))), kP0, kP1, kP2,
-                                              t1, u1, v1);
-            same &= lane_matches(m, t, u, v, l, h, t1, u1, v1);
-            hits += h;
+            KeptHit<M, float> h1;
+            const bool hit1 =
+                tri_test<M, float>(prepare<M>(load_rays<float>(rays, i + std::size_t(l))), kP0, kP1, kP2, h1);
+            same &= lane_matches(m, h, l, hit1, h1);
+            hits += hit1;
         }
     }
     if (!validated(state, same && hits > 0 && hits < rays.n, "packet lanes differ from the width-1 triangle test"))
         return;
     for (auto _ : state) {
-        F kt = F(0.0f), ku = F(0.0f), kv = F(0.0f);
+        KeptHit<M, F> kept;
         for (const auto& r : packets) {
-            F t = F(0.0f), u = F(0.0f), v = F(0.0f);
-            const mask_of<F> m = tri_test<M, F>(r, p0, p1, p2, t, u, v);
-            keep(m, t, u, v, kt, ku, kv);
+            KeptHit<M, F> h;
+            kept.keep(tri_test<M, F>(r, p0, p1, p2, h), h);
         }
-        publish(kt, ku, kv);
+        publish(kept);
     }
     set_tests_per_second(state, double(rays.n));
 }
@@ -151,26 +172,25 @@ void triangle_1xM(benchmark::State& state) {
     bool same = true;
     std::size_t hits = 0;
     for (std::size_t i = 0; i < rays.n; ++i) {
-        F t(0.0f), u(0.0f), v(0.0f);
-        const mask_of<F> m = tri_test<M, F>(broadcast[i], p0, p1, p2, t, u, v);
+        KeptHit<M, F> h;
+        const mask_of<F> m = tri_test<M, F>(broadcast[i], p0, p1, p2, h);
         const PreparedRay<M, float> r = prepare<M>(load_rays<float>(rays, i));
         for (int j = 0; j < Width; ++j) {
-            float t1 = 0, u1 = 0, v1 = 0;
-            const bool h = tri_test<M, float>(r, b.p(j, 0), b.p(j, 1), b.p(j, 2), t1, u1, v1);
-            same &= lane_matches(m, t, u, v, j, h, t1, u1, v1);
-            hits += h;
+            KeptHit<M, float> h1;
+            const bool hit1 = tri_test<M, float>(r, b.p(j, 0), b.p(j, 1), b.p(j, 2), h1);
+            same &= lane_matches(m, h, j, hit1, h1);
+            hits += hit1;
         }
     }
     if (!validated(state, same && hits > 0 && hits < rays.n * Width, "block lanes differ from the width-1 triangle test"))
         return;
     for (auto _ : state) {
-        F kt = F(0.0f), ku = F(0.0f), kv = F(0.0f);
+        KeptHit<M, F> kept;
         for (const auto& r : broadcast) {
-            F t = F(0.0f), u = F(0.0f), v = F(0.0f);
-            const mask_of<F> m = tri_test<M, F>(r, p0, p1, p2, t, u, v);
-            keep(m, t, u, v, kt, ku, kv);
+            KeptHit<M, F> h;
+            kept.keep(tri_test<M, F>(r, p0, p1, p2, h), h);
         }
-        publish(kt, ku, kv);
+        publish(kept);
     }
     set_tests_per_second(state, double(rays.n) * Width);
 }

@@ -57,6 +57,18 @@ inline constexpr auto kMinDet = std::numeric_limits<std::conditional_t<std::is_s
 
 }  // namespace triangle_detail
 
+/// A Moeller hit's u and v before their division by det. The test itself
+/// needs only t, so the two products that make u and v are left to whoever
+/// keeps the hit, to be done once for the hit that ends up closest (Embree's
+/// MoellerTrumboreHitM::finalize defers them the same way); u() and v() are
+/// the kernel's u and v bit for bit.
+template <class F>
+struct MoellerUV {
+    F U, V, inv_det;
+    RAYPACK_INLINE F u() const { return U * inv_det; }
+    RAYPACK_INLINE F v() const { return V * inv_det; }
+};
+
 /// Moeller & Trumbore, "Fast, Minimum Storage Ray/Triangle Intersection",
 /// JGT 1997. With tvec = o - p0, pvec = d x e2 and qvec = tvec x e1, MT's
 /// quantities are det = e1 . pvec, U = tvec . pvec, V = d . qvec,
@@ -69,32 +81,17 @@ inline constexpr auto kMinDet = std::numeric_limits<std::conditional_t<std::is_s
 /// division comes last, for the lanes that passed them. A determinant below
 /// the smallest normal float (ray parallel to the plane, degenerate
 /// triangle) is a miss.
+///
+/// This is the per-ray part, with u, v deferred, for
+/// triangles stored with their edges e1n = p0 - p1, e2 = p2 - p0 and
+/// ng = fused_cross(e1n, e2) (fused_cross, so that the results are the same
+/// bit for bit). `uv` is defined wherever the result is.
 template <class F>
-RAYPACK_INLINE mask_of<F> intersect_triangle_moeller_edges(mask_of<F> valid, const Vec3<F>& org,
-                                                           const Vec3<F>& dir, const F& tnear, const F& tfar,
-                                                           const Vec3<F>& p0, const Vec3<F>& e1n,
-                                                           const Vec3<F>& e2, const Vec3<F>& ng, F& t, F& u,
-                                                           F& v);
-
-template <class F>
-RAYPACK_INLINE mask_of<F> intersect_triangle_moeller(mask_of<F> valid, const Vec3<F>& org, const Vec3<F>& dir,
-                                                     const F& tnear, const F& tfar, const Vec3<F>& p0,
-                                                     const Vec3<F>& p1, const Vec3<F>& p2, F& t, F& u, F& v) {
-    const Vec3<F> e1n = p0 - p1;  // -e1
-    const Vec3<F> e2 = p2 - p0;
-    const Vec3<F> ng = fused_cross(e1n, e2);  // e2 x e1
-    return intersect_triangle_moeller_edges<F>(valid, org, dir, tnear, tfar, p0, e1n, e2, ng, t, u, v);
-}
-
-/// The per-ray part of intersect_triangle_moeller, for triangles stored with
-/// their edges e1n = p0 - p1, e2 = p2 - p0 and ng = fused_cross(e1n, e2)
-/// (fused_cross, so that the results are the same bit for bit).
-template <class F>
-RAYPACK_INLINE mask_of<F> intersect_triangle_moeller_edges(mask_of<F> valid, const Vec3<F>& org,
-                                                           const Vec3<F>& dir, const F& tnear, const F& tfar,
-                                                           const Vec3<F>& p0, const Vec3<F>& e1n,
-                                                           const Vec3<F>& e2, const Vec3<F>& ng, F& t, F& u,
-                                                           F& v) {
+RAYPACK_INLINE mask_of<F> intersect_triangle_moeller_deferred(mask_of<F> valid, const Vec3<F>& org,
+                                                              const Vec3<F>& dir, const F& tnear, const F& tfar,
+                                                              const Vec3<F>& p0, const Vec3<F>& e1n,
+                                                              const Vec3<F>& e2, const Vec3<F>& ng, F& t,
+                                                              MoellerUV<F>& uv) {
     using namespace triangle_detail;
     const Vec3<F> w = p0 - org;        // -tvec
     const Vec3<F> s = fused_cross(dir, w);  // tvec x d
@@ -103,14 +100,60 @@ RAYPACK_INLINE mask_of<F> intersect_triangle_moeller_edges(mask_of<F> valid, con
     const F V = fused_dot(e1n, s);
     const F sign = sign_bit(det), abs_det = vabs(det);
     const F Us = flip_sign(U, sign), Vs = flip_sign(V, sign);
-    valid = valid & (abs_det >= F(kMinDet<F>)) & (Us >= F(0)) & (Vs >= F(0)) & (Us + Vs <= abs_det);
+    // abs_det >= kMinDet, Us >= 0, Vs >= 0 and Us + Vs <= abs_det as one
+    // compare of their least margin: a difference of two finite floats has
+    // the sign of the exact one, so each margin is >= 0 exactly when its test
+    // holds. Compares are what a packet pays extra over a single ray (at 16
+    // lanes each one takes a whole FMA-pipe cycle; min and sub run beside
+    // them). vmin returns its second operand on NaN, and any NaN in U, V, det
+    // reaches `slack`, which comes last: such lanes miss.
+    const F slack = abs_det - (Us + Vs);
+    const F least = vmin(vmin(vmin(Us, Vs), abs_det - F(kMinDet<F>)), slack);
+    valid = valid & (least >= F(0));
     if (none(valid)) return valid;
     const F T = fused_dot(w, ng);
-    const F inv_det = F(1) / det;
-    t = T * inv_det;
-    valid = valid & (t >= tnear) & (t <= tfar);
-    u = U * inv_det;
-    v = V * inv_det;
+    uv = {U, V, F(1) / det};
+    t = T * uv.inv_det;
+    return valid & (t >= tnear) & (t <= tfar);
+}
+
+/// intersect_triangle_moeller_deferred with u and v made at once.
+template <class F>
+RAYPACK_INLINE mask_of<F> intersect_triangle_moeller_edges(mask_of<F> valid, const Vec3<F>& org,
+                                                           const Vec3<F>& dir, const F& tnear, const F& tfar,
+                                                           const Vec3<F>& p0, const Vec3<F>& e1n,
+                                                           const Vec3<F>& e2, const Vec3<F>& ng, F& t, F& u,
+                                                           F& v) {
+    MoellerUV<F> uv;
+    valid = intersect_triangle_moeller_deferred<F>(valid, org, dir, tnear, tfar, p0, e1n, e2, ng, t, uv);
+    if (none(valid)) return valid;
+    u = uv.u();
+    v = uv.v();
+    return valid;
+}
+
+/// The whole test, per-triangle part (the edges and ng) included, with u,
+/// v deferred ...
+template <class F>
+RAYPACK_INLINE mask_of<F> intersect_triangle_moeller(mask_of<F> valid, const Vec3<F>& org, const Vec3<F>& dir,
+                                                     const F& tnear, const F& tfar, const Vec3<F>& p0,
+                                                     const Vec3<F>& p1, const Vec3<F>& p2, F& t, MoellerUV<F>& uv) {
+    const Vec3<F> e1n = p0 - p1;  // -e1
+    const Vec3<F> e2 = p2 - p0;
+    const Vec3<F> ng = fused_cross(e1n, e2);  // e2 x e1
+    return intersect_triangle_moeller_deferred<F>(valid, org, dir, tnear, tfar, p0, e1n, e2, ng, t, uv);
+}
+
+/// ... or made at once.
+template <class F>
+RAYPACK_INLINE mask_of<F> intersect_triangle_moeller(mask_of<F> valid, const Vec3<F>& org, const Vec3<F>& dir,
+                                                     const F& tnear, const F& tfar, const Vec3<F>& p0,
+                                                     const Vec3<F>& p1, const Vec3<F>& p2, F& t, F& u, F& v) {
+    MoellerUV<F> uv;
+    valid = intersect_triangle_moeller<F>(valid, org, dir, tnear, tfar, p0, p1, p2, t, uv);
+    if (none(valid)) return valid;
+    u = uv.u();
+    v = uv.v();
     return valid;
 }
 

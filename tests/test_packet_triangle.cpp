@@ -422,6 +422,72 @@ TYPED_TEST(PacketTriangle, AdversarialRaysEqualWidthOne) {
     }
 }
 
+/// Moeller with u, v deferred (MoellerUV) at width K: the same lanes and t as
+/// the immediate form, and u(), v() its u, v bit for bit.
+template <int K>
+::testing::AssertionResult deferred_matches_immediate(const Cases& c) {
+    using F = vfloat<K>;
+    const Answers want = run_lanes<K>(TriangleMethod::Moeller, c);
+    std::size_t bad = 0, hits = 0;
+    for (std::size_t i = 0; i + K <= c.size(); i += K) {
+        auto L = [&](int field) { return load_lanes<F>(&c.f[field][i]); };
+        const Vec3<F> o{L(Cases::OX), L(Cases::OY), L(Cases::OZ)}, d{L(Cases::DX), L(Cases::DY), L(Cases::DZ)};
+        const Vec3<F> p0{L(Cases::AX), L(Cases::AY), L(Cases::AZ)}, p1{L(Cases::BX), L(Cases::BY), L(Cases::BZ)},
+            p2{L(Cases::CX), L(Cases::CY), L(Cases::CZ)};
+        F t = F(0.0f);
+        MoellerUV<F> uv{F(0.0f), F(0.0f), F(0.0f)};
+        const std::uint32_t bits = mask_bits(
+            intersect_triangle_moeller<F>(mask_of<F>(true), o, d, L(Cases::TN), L(Cases::TF), p0, p1, p2, t, uv));
+        const F u = uv.u(), v = uv.v();
+        for (int l = 0; l < K; ++l) {
+            const std::size_t j = i + std::size_t(l);
+            const bool h = (bits >> l) & 1u;
+            hits += h;
+            bad += h != (want.hit[j] != 0) ||
+                   (h && !(same_bits(lane(t, l), want.t[j]) && same_bits(lane(u, l), want.u[j]) &&
+                           same_bits(lane(v, l), want.v[j])));
+        }
+    }
+    if (bad == 0 && hits > 0) return ::testing::AssertionSuccess();
+    return ::testing::AssertionFailure() << bad << " of " << c.size() << " lanes differ (" << hits << " hits)";
+}
+
+TYPED_TEST(PacketTriangle, MoellerDeferredUVEqualsImmediate) {
+    constexpr int K = TypeParam::value;
+    Cases c;
+    packet_chunk(0, c);
+    EXPECT_TRUE(deferred_matches_immediate<K>(c)) << "random rays";
+    EXPECT_TRUE(deferred_matches_immediate<K>(adversarial_cases(77))) << "adversarial rays";
+}
+
+/// The Moeller edge test folds its four compares into one (the least
+/// margin); a NaN anywhere, or products that overflow, must still miss, as
+/// the separate compares did, at every width.
+TYPED_TEST(PacketTriangle, MoellerNonFiniteQuantitiesMiss) {
+    constexpr int K = TypeParam::value;
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const Tri unit{{-1, -1, 0}, {1, -1, 0}, {0, 1, 0}};
+    const float h = 1e30f;
+    const Tri huge{{-h, -h, 0}, {h, -h, 0}, {0, h, 0}};  // edge products overflow: U, V, det are inf or NaN
+    Cases c;
+    for (std::size_t i = 0; i < 4 * std::size_t(K); ++i) {
+        const float x = 0.1f * float(i % 5) - 0.2f;
+        switch (i % 4) {
+            case 0: c.add({{x, 0.0f, -1.0f}, {nan, 0.0f, 1.0f}}, unit); break;
+            case 1: c.add({{x, 0.0f, -1.0f}, {0.0f, nan, 1.0f}}, unit); break;
+            case 2: c.add({{nan, 0.0f, -1.0f}, {0.0f, 0.0f, 1.0f}}, unit); break;
+            default: c.add({{x, 0.0f, -1.0f}, {0.0f, 0.0f, 1.0f}}, huge); break;
+        }
+    }
+    const Answers got = run_lanes<K>(TriangleMethod::Moeller, c);
+    for (std::size_t i = 0; i < c.size(); ++i) EXPECT_EQ(got.hit[i], 0) << "pair " << i << ": " << str(c.ray(i), c.tri(i));
+    // The same rays with finite values hit: the misses above come from the non-finite quantities.
+    Cases finite;
+    for (std::size_t i = 0; i < std::size_t(K); ++i) finite.add({{0.0f, 0.0f, -1.0f}, {0.0f, 0.0f, 1.0f}}, unit);
+    const Answers ok = run_lanes<K>(TriangleMethod::Moeller, finite);
+    for (std::size_t i = 0; i < finite.size(); ++i) EXPECT_EQ(ok.hit[i], 1) << "pair " << i;
+}
+
 // ---- Closed meshes: watertightness -------------------------------------------------
 
 /// Octahedron with vertices +-1 on the axes around `c`, consistently wound.

@@ -85,32 +85,6 @@ RAYPACK_INLINE LeafRay<F> make_leaf_ray(const Rayf& r, TriangleMethod method) {
     return l;
 }
 
-/// Moeller-Trumbore on precomputed edges: the operations of
-/// intersect_triangle_moeller (kernels/triangle.h) after its per-triangle
-/// part, in the same order, so t, u, v are the kernel's bit for bit.
-template <class F>
-RAYPACK_INLINE mask_of<F> intersect_moeller_edges(const Vec3<F>& org, const Vec3<F>& dir, const F& tnear,
-                                                  const F& tfar, const Vec3<F>& p0, const Vec3<F>& e1n,
-                                                  const Vec3<F>& e2, const Vec3<F>& ng, F& t, F& u, F& v) {
-    using namespace triangle_detail;
-    const Vec3<F> w = p0 - org;
-    const Vec3<F> s = fused_cross(dir, w);
-    const F det = fused_dot(dir, ng);
-    const F U = fused_dot(e2, s);
-    const F V = fused_dot(e1n, s);
-    const F sign = sign_bit(det), abs_det = vabs(det);
-    const F Us = flip_sign(U, sign), Vs = flip_sign(V, sign);
-    mask_of<F> valid = (abs_det >= F(kMinDet<F>)) & (Us >= F(0)) & (Vs >= F(0)) & (Us + Vs <= abs_det);
-    if (none(valid)) return valid;
-    const F T = fused_dot(w, ng);
-    const F inv_det = F(1) / det;
-    t = T * inv_det;
-    valid = valid & (t >= tnear) & (t <= tfar);
-    u = U * inv_det;
-    v = V * inv_det;
-    return valid;
-}
-
 template <class F>
 RAYPACK_INLINE Vec3<F> load_vec(const float (&p)[3][lanes_of<F>]) {
     return {F::load_unaligned(p[0]), F::load_unaligned(p[1]), F::load_unaligned(p[2])};
@@ -123,7 +97,8 @@ RAYPACK_INLINE mask_of<F> intersect_block(const TriangleBlock<M>& b, const LeafR
     const mask_of<F> all(true);
     const Vec3<F> p0 = load_vec<F>(b.p0), a = load_vec<F>(b.a), c = load_vec<F>(b.b);
     if constexpr (Method == TriangleMethod::Moeller) {
-        return intersect_moeller_edges(r.org, r.dir, r.tnear, tfar, p0, a, c, load_vec<F>(b.ng), t, u, v);
+        return intersect_triangle_moeller_edges<F>(all, r.org, r.dir, r.tnear, tfar, p0, a, c, load_vec<F>(b.ng), t, u,
+                                                   v);
     } else if constexpr (Method == TriangleMethod::Watertight) {
         return intersect_triangle_watertight<F>(all, r.watertight, r.tnear, tfar, p0, a, c, t, u, v);
     } else {

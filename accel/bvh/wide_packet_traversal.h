@@ -136,7 +136,7 @@ RAYPACK_INLINE mask_of<F> intersect_one(const TriangleBlock<M>& b, int j, Sphere
     const Vec3<F> c{F(b.b[0][j]), F(b.b[1][j]), F(b.b[2][j])};
     if constexpr (TM == TriangleMethod::Moeller) {
         const Vec3<F> ng{F(b.ng[0][j]), F(b.ng[1][j]), F(b.ng[2][j])};
-        return active & intersect_moeller_edges(r.org, r.dir, r.tnear, tfar, p0, a, c, ng, t, u, v);
+        return intersect_triangle_moeller_edges<F>(active, r.org, r.dir, r.tnear, tfar, p0, a, c, ng, t, u, v);
     } else if constexpr (TM == TriangleMethod::Watertight) {
         return intersect_triangle_watertight<F>(active, r.watertight, r.tnear, tfar, p0, a, c, t, u, v);
     } else {
