@@ -100,16 +100,7 @@ RAYPACK_INLINE mask_of<F> intersect_triangle_moeller_deferred(mask_of<F> valid, 
     const F V = fused_dot(e1n, s);
     const F sign = sign_bit(det), abs_det = vabs(det);
     const F Us = flip_sign(U, sign), Vs = flip_sign(V, sign);
-    // abs_det >= kMinDet, Us >= 0, Vs >= 0 and Us + Vs <= abs_det as one
-    // compare of their least margin: a difference of two finite floats has
-    // the sign of the exact one, so each margin is >= 0 exactly when its test
-    // holds. Compares are what a packet pays extra over a single ray (at 16
-    // lanes each one takes a whole FMA-pipe cycle; min and sub run beside
-    // them). vmin returns its second operand on NaN, and any NaN in U, V, det
-    // reaches `slack`, which comes last: such lanes miss.
-    const F slack = abs_det - (Us + Vs);
-    const F least = vmin(vmin(vmin(Us, Vs), abs_det - F(kMinDet<F>)), slack);
-    valid = valid & (least >= F(0));
+    valid = valid & (abs_det >= F(kMinDet<F>)) & (Us >= F(0)) & (Vs >= F(0)) & (Us + Vs <= abs_det);
     if (none(valid)) return valid;
     const F T = fused_dot(w, ng);
     uv = {U, V, F(1) / det};

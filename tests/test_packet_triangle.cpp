@@ -460,9 +460,9 @@ TYPED_TEST(PacketTriangle, MoellerDeferredUVEqualsImmediate) {
     EXPECT_TRUE(deferred_matches_immediate<K>(adversarial_cases(77))) << "adversarial rays";
 }
 
-/// The Moeller edge test folds its four compares into one (the least
-/// margin); a NaN anywhere, or products that overflow, must still miss, as
-/// the separate compares did, at every width.
+/// A NaN anywhere in the Moeller test, or products that overflow, make a
+/// miss at every width (a change of the edge compares, such as folding them
+/// into one compare of the least margin, has to keep that).
 TYPED_TEST(PacketTriangle, MoellerNonFiniteQuantitiesMiss) {
     constexpr int K = TypeParam::value;
     const float nan = std::numeric_limits<float>::quiet_NaN();
