@@ -146,7 +146,7 @@ RAYPACK_INLINE xsimd::batch<float, A> vmax(const xsimd::batch<float, A>& a, cons
 /// FMA overwrites one of its inputs, and gcc 12 then reloads an operand that
 /// is used twice from memory instead of copying the register (a copy is free
 /// at rename). At 512 bits those reloads, not the arithmetic, limited the
-/// packet slab test on Zen 5 (aabb/plain/16: 3.8 -> 4.8 G tests/s).
+/// packet slab test on Zen 4 (aabb/plain/16: 3.8 -> 4.8 G tests/s).
 template <class F>
 RAYPACK_INLINE void keep_in_register(F& v) {
     if constexpr (std::is_floating_point_v<F>) {

@@ -72,7 +72,7 @@ RAYPACK_INLINE F node_tfar(const F& tfar) {
 /// = rdir), i.e. Ize's widening dropped and nothing else; the fused form
 /// (NodeTest::Plain) was measured slower (see NodeTest), so this is the fast
 /// form here, and it loses hits exactly where the widening matters. Measured
-/// (Zen 5, gen:balls:4, 512 x 512, K = 1, 8, 16): within 3% of robust, i.e.
+/// (Zen 4, gen:balls:4, 512 x 512, K = 1, 8, 16): within 3% of robust, i.e.
 /// the robust test costs the wide trees nothing, unlike bvh2 (1.5x).
 template <NodeTest Test, int N>
 RAYPACK_INLINE NodeRay<N> make_node_ray(const Rayf& ray, SlabMethod slabs = SlabMethod::Robust,
