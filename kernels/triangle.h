@@ -82,10 +82,10 @@ struct MoellerUV {
 /// the smallest normal float (ray parallel to the plane, degenerate
 /// triangle) is a miss.
 ///
-/// This is the per-ray part, with u, v deferred, for
-/// triangles stored with their edges e1n = p0 - p1, e2 = p2 - p0 and
-/// ng = fused_cross(e1n, e2) (fused_cross, so that the results are the same
-/// bit for bit). `uv` is defined wherever the result is.
+/// This is the per-ray part, with u, v deferred, for triangles stored with
+/// their edges e1n = p0 - p1, e2 = p2 - p0 and ng = fused_cross(e1n, e2)
+/// (fused_cross, so that the results are the same bit for bit; see
+/// triangle_detail::moeller_edges). `uv` is defined wherever the result is.
 template <class F>
 RAYPACK_INLINE mask_of<F> intersect_triangle_moeller_deferred(mask_of<F> valid, const Vec3<F>& org,
                                                               const Vec3<F>& dir, const F& tnear, const F& tfar,
@@ -108,7 +108,8 @@ RAYPACK_INLINE mask_of<F> intersect_triangle_moeller_deferred(mask_of<F> valid, 
     return valid & (t >= tnear) & (t <= tfar);
 }
 
-/// intersect_triangle_moeller_deferred with u and v made at once.
+/// intersect_triangle_moeller_deferred with u and v made at once (only when
+/// some lane hit).
 template <class F>
 RAYPACK_INLINE mask_of<F> intersect_triangle_moeller_edges(mask_of<F> valid, const Vec3<F>& org,
                                                            const Vec3<F>& dir, const F& tnear, const F& tfar,
@@ -123,29 +124,38 @@ RAYPACK_INLINE mask_of<F> intersect_triangle_moeller_edges(mask_of<F> valid, con
     return valid;
 }
 
-/// The whole test, per-triangle part (the edges and ng) included, with u,
-/// v deferred ...
+namespace triangle_detail {
+
+/// Moeller's per-triangle part: the edges and ng the per-ray part takes.
+template <class F>
+struct MoellerEdges {
+    Vec3<F> e1n, e2, ng;
+};
+template <class F>
+RAYPACK_INLINE MoellerEdges<F> moeller_edges(const Vec3<F>& p0, const Vec3<F>& p1, const Vec3<F>& p2) {
+    const Vec3<F> e1n = p0 - p1;  // -e1
+    const Vec3<F> e2 = p2 - p0;
+    return {e1n, e2, fused_cross(e1n, e2)};  // ng = e2 x e1
+}
+
+}  // namespace triangle_detail
+
+/// The whole test, per-triangle part included, with u, v deferred ...
 template <class F>
 RAYPACK_INLINE mask_of<F> intersect_triangle_moeller(mask_of<F> valid, const Vec3<F>& org, const Vec3<F>& dir,
                                                      const F& tnear, const F& tfar, const Vec3<F>& p0,
                                                      const Vec3<F>& p1, const Vec3<F>& p2, F& t, MoellerUV<F>& uv) {
-    const Vec3<F> e1n = p0 - p1;  // -e1
-    const Vec3<F> e2 = p2 - p0;
-    const Vec3<F> ng = fused_cross(e1n, e2);  // e2 x e1
-    return intersect_triangle_moeller_deferred<F>(valid, org, dir, tnear, tfar, p0, e1n, e2, ng, t, uv);
+    const auto e = triangle_detail::moeller_edges(p0, p1, p2);
+    return intersect_triangle_moeller_deferred<F>(valid, org, dir, tnear, tfar, p0, e.e1n, e.e2, e.ng, t, uv);
 }
 
-/// ... or made at once.
+/// ... or with u, v made at once.
 template <class F>
 RAYPACK_INLINE mask_of<F> intersect_triangle_moeller(mask_of<F> valid, const Vec3<F>& org, const Vec3<F>& dir,
                                                      const F& tnear, const F& tfar, const Vec3<F>& p0,
                                                      const Vec3<F>& p1, const Vec3<F>& p2, F& t, F& u, F& v) {
-    MoellerUV<F> uv;
-    valid = intersect_triangle_moeller<F>(valid, org, dir, tnear, tfar, p0, p1, p2, t, uv);
-    if (none(valid)) return valid;
-    u = uv.u();
-    v = uv.v();
-    return valid;
+    const auto e = triangle_detail::moeller_edges(p0, p1, p2);
+    return intersect_triangle_moeller_edges<F>(valid, org, dir, tnear, tfar, p0, e.e1n, e.e2, e.ng, t, u, v);
 }
 
 /// Per-ray part of the watertight test (Woop, Benthin & Wald, "Watertight

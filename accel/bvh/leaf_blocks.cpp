@@ -37,11 +37,10 @@ void pack_triangles(TriangleBlock<M>& block, std::span<const std::uint32_t> prim
         block.prim[lane] = prims[j];
         set3(block.p0, lane, p0);
         if (layout == TriangleLayout::Edges) {
-            // Exactly the per-triangle part of intersect_triangle_moeller.
-            const Vec3f e1n = p0 - p1, e2 = p2 - p0;
-            set3(block.a, lane, e1n);
-            set3(block.b, lane, e2);
-            set3(block.ng, lane, fused_cross(e1n, e2));
+            const auto e = triangle_detail::moeller_edges(p0, p1, p2);  // what intersect_triangle_moeller computes
+            set3(block.a, lane, e.e1n);
+            set3(block.b, lane, e.e2);
+            set3(block.ng, lane, e.ng);
         } else {
             set3(block.a, lane, p1);
             set3(block.b, lane, p2);
