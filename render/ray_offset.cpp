@@ -50,7 +50,10 @@ std::optional<OffsetPolicy> parse_offset_policy(const std::string& name) {
 
 std::string offset_policy_list() {
     std::string out;
-    for (OffsetPolicy p : kPolicies) out += (out.empty() ? "" : "|") + std::string(offset_policy_name(p));
+    for (OffsetPolicy p : kPolicies) {
+        if (!out.empty()) out += '|';
+        out += offset_policy_name(p);
+    }
     return out;
 }
 
