@@ -77,10 +77,17 @@ struct MoellerUV {
 ///   det = d . ng,  U = e2 . s,  V = -e1 . s,  T = -tvec . ng,
 /// with ng = e2 x e1 per triangle and s = d x (p0 - o) per ray: one cross
 /// product per test instead of two. Two-sided: the edge tests compare the
-/// undivided U, V (sign of det folded in) against |det|, and the one
-/// division comes last, for the lanes that passed them. A determinant below
+/// undivided U, V (sign of det folded in) against |det|. A determinant below
 /// the smallest normal float (ray parallel to the plane, degenerate
-/// triangle) is a miss.
+/// triangle) is a miss, and so is any lane where a quantity is NaN.
+///
+/// Up to width 8 the division comes last, for the lanes that passed the
+/// edge tests, and the kernel returns early when none did. At width 16
+/// (kMaskRegisters) a packet rarely fails as a whole while each compare
+/// costs as much as a multiply, so the kernel runs straight through: the
+/// division issues first, being the longest in latency, and the four edge
+/// conditions fold into the least of their margins and one compare. Every
+/// width computes the same values and the same hits.
 ///
 /// This is the per-ray part, with u, v deferred, for triangles stored with
 /// their edges e1n = p0 - p1, e2 = p2 - p0 and ng = fused_cross(e1n, e2)
@@ -93,19 +100,35 @@ RAYPACK_INLINE mask_of<F> intersect_triangle_moeller_deferred(mask_of<F> valid, 
                                                               const Vec3<F>& e2, const Vec3<F>& ng, F& t,
                                                               MoellerUV<F>& uv) {
     using namespace triangle_detail;
-    const Vec3<F> w = p0 - org;        // -tvec
-    const Vec3<F> s = fused_cross(dir, w);  // tvec x d
+    const Vec3<F> w = p0 - org;  // -tvec
     const F det = fused_dot(dir, ng);
-    const F U = fused_dot(e2, s);
-    const F V = fused_dot(e1n, s);
-    const F sign = sign_bit(det), abs_det = vabs(det);
-    const F Us = flip_sign(U, sign), Vs = flip_sign(V, sign);
-    valid = valid & (abs_det >= F(kMinDet<F>)) & (Us >= F(0)) & (Vs >= F(0)) & (Us + Vs <= abs_det);
-    if (none(valid)) return valid;
-    const F T = fused_dot(w, ng);
-    uv = {U, V, F(1) / det};
-    t = T * uv.inv_det;
-    return valid & (t >= tnear) & (t <= tfar);
+    if constexpr (kMaskRegisters<F>) {
+        uv.inv_det = F(1) / det;
+        t = fused_dot(w, ng) * uv.inv_det;
+        const Vec3<F> s = fused_cross(dir, w);  // tvec x d
+        uv.U = fused_dot(e2, s);
+        uv.V = fused_dot(e1n, s);
+        const F sign = sign_bit(det), abs_det = vabs(det);
+        const F Us = flip_sign(uv.U, sign), Vs = flip_sign(uv.V, sign);
+        // The margins' least is >= 0 exactly when each is (a difference of
+        // floats has the sign of the exact one). vmin returns its second
+        // operand when either is NaN, and W is NaN whenever U, V or det is.
+        const F W = abs_det - (Us + Vs);
+        const F margin = vmin(vmin(Us, Vs), vmin(abs_det - F(kMinDet<F>), W));
+        return valid & (margin >= F(0)) & (t >= tnear) & (t <= tfar);
+    } else {
+        const Vec3<F> s = fused_cross(dir, w);  // tvec x d
+        const F U = fused_dot(e2, s);
+        const F V = fused_dot(e1n, s);
+        const F sign = sign_bit(det), abs_det = vabs(det);
+        const F Us = flip_sign(U, sign), Vs = flip_sign(V, sign);
+        valid = valid & (abs_det >= F(kMinDet<F>)) & (Us >= F(0)) & (Vs >= F(0)) & (abs_det - (Us + Vs) >= F(0));
+        if (none(valid)) return valid;
+        const F T = fused_dot(w, ng);
+        uv = {U, V, F(1) / det};
+        t = T * uv.inv_det;
+        return valid & (t >= tnear) & (t <= tfar);
+    }
 }
 
 /// intersect_triangle_moeller_deferred with u and v made at once (only when
@@ -124,29 +147,18 @@ RAYPACK_INLINE mask_of<F> intersect_triangle_moeller_edges(mask_of<F> valid, con
     return valid;
 }
 
-namespace triangle_detail {
-
-/// Moeller's per-triangle part: the edges and ng the per-ray part takes.
-template <class F>
-struct MoellerEdges {
-    Vec3<F> e1n, e2, ng;
-};
-template <class F>
-RAYPACK_INLINE MoellerEdges<F> moeller_edges(const Vec3<F>& p0, const Vec3<F>& p1, const Vec3<F>& p2) {
-    const Vec3<F> e1n = p0 - p1;  // -e1
-    const Vec3<F> e2 = p2 - p0;
-    return {e1n, e2, fused_cross(e1n, e2)};  // ng = e2 x e1
-}
-
-}  // namespace triangle_detail
-
 /// The whole test, per-triangle part included, with u, v deferred ...
+/// The edges stay separate values here: as one aggregate (9 vectors, 576
+/// bytes at width 16) gcc kept them in memory and stored them again on
+/// every iteration of the callers' loops, which, depending on the build's
+/// layout, made triangle/moeller/4 up to 5x slower.
 template <class F>
 RAYPACK_INLINE mask_of<F> intersect_triangle_moeller(mask_of<F> valid, const Vec3<F>& org, const Vec3<F>& dir,
                                                      const F& tnear, const F& tfar, const Vec3<F>& p0,
                                                      const Vec3<F>& p1, const Vec3<F>& p2, F& t, MoellerUV<F>& uv) {
-    const auto e = triangle_detail::moeller_edges(p0, p1, p2);
-    return intersect_triangle_moeller_deferred<F>(valid, org, dir, tnear, tfar, p0, e.e1n, e.e2, e.ng, t, uv);
+    const Vec3<F> e1n = p0 - p1, e2 = p2 - p0;  // triangle_detail::moeller_edges
+    return intersect_triangle_moeller_deferred<F>(valid, org, dir, tnear, tfar, p0, e1n, e2, fused_cross(e1n, e2), t,
+                                                  uv);
 }
 
 /// ... or with u, v made at once.
@@ -154,9 +166,27 @@ template <class F>
 RAYPACK_INLINE mask_of<F> intersect_triangle_moeller(mask_of<F> valid, const Vec3<F>& org, const Vec3<F>& dir,
                                                      const F& tnear, const F& tfar, const Vec3<F>& p0,
                                                      const Vec3<F>& p1, const Vec3<F>& p2, F& t, F& u, F& v) {
-    const auto e = triangle_detail::moeller_edges(p0, p1, p2);
-    return intersect_triangle_moeller_edges<F>(valid, org, dir, tnear, tfar, p0, e.e1n, e.e2, e.ng, t, u, v);
+    const Vec3<F> e1n = p0 - p1, e2 = p2 - p0;
+    return intersect_triangle_moeller_edges<F>(valid, org, dir, tnear, tfar, p0, e1n, e2, fused_cross(e1n, e2), t, u,
+                                               v);
 }
+
+namespace triangle_detail {
+
+/// Moeller's per-triangle part, for triangles stored with their edges: the
+/// values intersect_triangle_moeller computes from the vertices.
+template <class F>
+struct MoellerEdges {
+    Vec3<F> e1n, e2, ng;
+};
+template <class F>
+MoellerEdges<F> moeller_edges(const Vec3<F>& p0, const Vec3<F>& p1, const Vec3<F>& p2) {
+    const Vec3<F> e1n = p0 - p1;  // -e1
+    const Vec3<F> e2 = p2 - p0;
+    return {e1n, e2, fused_cross(e1n, e2)};  // ng = e2 x e1
+}
+
+}  // namespace triangle_detail
 
 /// Per-ray part of the watertight test (Woop, Benthin & Wald, "Watertight
 /// Ray/Triangle Intersection", JCGT 2(1) 2013): kz = argmax |d|, kx and ky

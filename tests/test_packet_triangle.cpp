@@ -469,21 +469,30 @@ TYPED_TEST(PacketTriangle, MoellerNonFiniteQuantitiesMiss) {
     const Tri unit{{-1, -1, 0}, {1, -1, 0}, {0, 1, 0}};
     const float h = 1e30f;
     const Tri huge{{-h, -h, 0}, {h, -h, 0}, {0, h, 0}};  // edge products overflow: U, V, det are inf or NaN
+    // In the plane x = 0, around the origin, which the ray below reaches at
+    // t = 1 with det = T = -4; but d x (p0 - o) is inf - inf in x, so U and
+    // V alone are NaN (the case width 16's folded edge test must catch).
+    const Tri upright{{0, -1, -1}, {0, 1, -1}, {0, 0, 1}};
+    const float g = 2e38f;
     Cases c;
-    for (std::size_t i = 0; i < 4 * std::size_t(K); ++i) {
+    for (std::size_t i = 0; i < 5 * std::size_t(K); ++i) {
         const float x = 0.1f * float(i % 5) - 0.2f;
-        switch (i % 4) {
+        switch (i % 5) {
             case 0: c.add({{x, 0.0f, -1.0f}, {nan, 0.0f, 1.0f}}, unit); break;
             case 1: c.add({{x, 0.0f, -1.0f}, {0.0f, nan, 1.0f}}, unit); break;
             case 2: c.add({{nan, 0.0f, -1.0f}, {0.0f, 0.0f, 1.0f}}, unit); break;
-            default: c.add({{x, 0.0f, -1.0f}, {0.0f, 0.0f, 1.0f}}, huge); break;
+            case 3: c.add({{x, 0.0f, -1.0f}, {0.0f, 0.0f, 1.0f}}, huge); break;
+            default: c.add({{-1.0f, -g, -g}, {1.0f, g, g}}, upright); break;
         }
     }
     const Answers got = run_lanes<K>(TriangleMethod::Moeller, c);
     for (std::size_t i = 0; i < c.size(); ++i) EXPECT_EQ(got.hit[i], 0) << "pair " << i << ": " << str(c.ray(i), c.tri(i));
     // The same rays with finite values hit: the misses above come from the non-finite quantities.
     Cases finite;
-    for (std::size_t i = 0; i < std::size_t(K); ++i) finite.add({{0.0f, 0.0f, -1.0f}, {0.0f, 0.0f, 1.0f}}, unit);
+    for (std::size_t i = 0; i < std::size_t(K); ++i) {
+        if (i % 2 == 0) finite.add({{0.0f, 0.0f, -1.0f}, {0.0f, 0.0f, 1.0f}}, unit);
+        else finite.add({{-1.0f, 0.0f, 0.0f}, {1.0f, 0.0f, 0.0f}}, upright);
+    }
     const Answers ok = run_lanes<K>(TriangleMethod::Moeller, finite);
     for (std::size_t i = 0; i < finite.size(); ++i) EXPECT_EQ(ok.hit[i], 1) << "pair " << i;
 }
