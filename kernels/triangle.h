@@ -85,9 +85,10 @@ struct MoellerUV {
 /// edge tests, and the kernel returns early when none did. At width 16
 /// (kMaskRegisters) a packet rarely fails as a whole while each compare
 /// costs as much as a multiply, so the kernel runs straight through: the
-/// division issues first, being the longest in latency, and the four edge
-/// conditions fold into the least of their margins and one compare. Every
-/// width computes the same values and the same hits.
+/// division issues first, being the longest in latency, and three of the
+/// edge conditions (U, V >= 0, |det| >= the least normal) fold into one
+/// compare of their least margin. Every width computes the same values and
+/// the same hits.
 ///
 /// This is the per-ray part, with u, v deferred, for triangles stored with
 /// their edges e1n = p0 - p1, e2 = p2 - p0 and ng = fused_cross(e1n, e2)
@@ -111,18 +112,17 @@ RAYPACK_INLINE mask_of<F> intersect_triangle_moeller_deferred(mask_of<F> valid, 
         const F sign = sign_bit(det), abs_det = vabs(det);
         const F Us = flip_sign(uv.U, sign), Vs = flip_sign(uv.V, sign);
         // The margins' least is >= 0 exactly when each is (a difference of
-        // floats has the sign of the exact one). vmin returns its second
-        // operand when either is NaN, and W is NaN whenever U, V or det is.
-        const F W = abs_det - (Us + Vs);
-        const F margin = vmin(vmin(Us, Vs), vmin(abs_det - F(kMinDet<F>), W));
-        return valid & (margin >= F(0)) & (t >= tnear) & (t <= tfar);
+        // floats has the sign of the exact one). vmin may drop a NaN of U or
+        // V, but then Us + Vs is NaN and fails its own compare.
+        const F margin = vmin(vmin(Us, Vs), abs_det - F(kMinDet<F>));
+        return valid & (margin >= F(0)) & (Us + Vs <= abs_det) & (t >= tnear) & (t <= tfar);
     } else {
         const Vec3<F> s = fused_cross(dir, w);  // tvec x d
         const F U = fused_dot(e2, s);
         const F V = fused_dot(e1n, s);
         const F sign = sign_bit(det), abs_det = vabs(det);
         const F Us = flip_sign(U, sign), Vs = flip_sign(V, sign);
-        valid = valid & (abs_det >= F(kMinDet<F>)) & (Us >= F(0)) & (Vs >= F(0)) & (abs_det - (Us + Vs) >= F(0));
+        valid = valid & (abs_det >= F(kMinDet<F>)) & (Us >= F(0)) & (Vs >= F(0)) & (Us + Vs <= abs_det);
         if (none(valid)) return valid;
         const F T = fused_dot(w, ng);
         uv = {U, V, F(1) / det};

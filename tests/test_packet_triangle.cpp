@@ -471,7 +471,8 @@ TYPED_TEST(PacketTriangle, MoellerNonFiniteQuantitiesMiss) {
     const Tri huge{{-h, -h, 0}, {h, -h, 0}, {0, h, 0}};  // edge products overflow: U, V, det are inf or NaN
     // In the plane x = 0, around the origin, which the ray below reaches at
     // t = 1 with det = T = -4; but d x (p0 - o) is inf - inf in x, so U and
-    // V alone are NaN (the case width 16's folded edge test must catch).
+    // V alone are NaN (width 16 folds the tests of U and V into one vmin,
+    // which may drop a NaN: the compare of U + V must catch it).
     const Tri upright{{0, -1, -1}, {0, 1, -1}, {0, 0, 1}};
     const float g = 2e38f;
     Cases c;
