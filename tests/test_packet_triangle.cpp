@@ -490,7 +490,7 @@ TYPED_TEST(PacketTriangle, MoellerNonFiniteQuantitiesMiss) {
     for (std::size_t i = 0; i < c.size(); ++i) EXPECT_EQ(got.hit[i], 0) << "pair " << i << ": " << str(c.ray(i), c.tri(i));
     // The same rays with finite values hit: the misses above come from the non-finite quantities.
     Cases finite;
-    for (std::size_t i = 0; i < std::size_t(K); ++i) {
+    for (std::size_t i = 0; i < 2 * std::size_t(K); ++i) {
         if (i % 2 == 0) finite.add({{0.0f, 0.0f, -1.0f}, {0.0f, 0.0f, 1.0f}}, unit);
         else finite.add({{-1.0f, 0.0f, 0.0f}, {1.0f, 0.0f, 0.0f}}, upright);
     }
