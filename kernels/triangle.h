@@ -106,22 +106,21 @@ RAYPACK_INLINE mask_of<F> intersect_triangle_moeller_deferred(mask_of<F> valid, 
     if constexpr (kMaskRegisters<F>) {
         uv.inv_det = F(1) / det;
         t = fused_dot(w, ng) * uv.inv_det;
-        const Vec3<F> s = fused_cross(dir, w);  // tvec x d
-        uv.U = fused_dot(e2, s);
-        uv.V = fused_dot(e1n, s);
-        const F sign = sign_bit(det), abs_det = vabs(det);
-        const F Us = flip_sign(uv.U, sign), Vs = flip_sign(uv.V, sign);
+    }
+    const Vec3<F> s = fused_cross(dir, w);  // tvec x d
+    const F U = fused_dot(e2, s);
+    const F V = fused_dot(e1n, s);
+    const F sign = sign_bit(det), abs_det = vabs(det);
+    const F Us = flip_sign(U, sign), Vs = flip_sign(V, sign);
+    if constexpr (kMaskRegisters<F>) {
+        uv.U = U;
+        uv.V = V;
         // The margins' least is >= 0 exactly when each is (a difference of
         // floats has the sign of the exact one). vmin may drop a NaN of U or
         // V, but then Us + Vs is NaN and fails its own compare.
         const F margin = vmin(vmin(Us, Vs), abs_det - F(kMinDet<F>));
         return valid & (margin >= F(0)) & (Us + Vs <= abs_det) & (t >= tnear) & (t <= tfar);
     } else {
-        const Vec3<F> s = fused_cross(dir, w);  // tvec x d
-        const F U = fused_dot(e2, s);
-        const F V = fused_dot(e1n, s);
-        const F sign = sign_bit(det), abs_det = vabs(det);
-        const F Us = flip_sign(U, sign), Vs = flip_sign(V, sign);
         valid = valid & (abs_det >= F(kMinDet<F>)) & (Us >= F(0)) & (Vs >= F(0)) & (Us + Vs <= abs_det);
         if (none(valid)) return valid;
         const F T = fused_dot(w, ng);
