@@ -9,6 +9,8 @@ builds a C++ harness around it (every vector register and the loop's base
 registers start from a buffer of small random floats, mask registers all
 ones), compiles it with -march=native and prints cycles per iteration,
 against a dependent-add clock calibration taken in the same process.
+x86-64 with AVX-512 (the harness sets all 32 zmm registers); the loop must
+be straight-line code that steps a pointer and ends in cmp + jne.
 
 Edits drop or rewrite lines before timing; a removed instruction must not
 leave a value to be carried from one iteration to the next, or the copy
@@ -105,10 +107,8 @@ def harness(body, calibration_adds=1 << 22):
     gprs = sorted({r for i in body for r in re.findall(r"\((%r\w+)", i)} - {ptr})
     iterations = 32
     buf_floats = (iterations * stride + 8192) // 4
-    asm = []
-    for i, ins in enumerate(body[:-1]):
-        asm.append(ins)
-    asm_text = "".join('      "{}\\n"\n'.format(i.replace("%", "%%").replace("{", "%{").replace("}", "%}")) for i in asm)
+    asm_text = "".join('      "{}\\n"\n'.format(i.replace("%", "%%").replace("{", "%{").replace("}", "%}"))
+                       for i in body[:-1])
     init = "".join(f'      "vbroadcastss {4 * r}(%[buf]), %%zmm{r}\\n"\n' for r in range(32))
     init += "".join(f'      "kxnorw %%k{k}, %%k{k}, %%k{k}\\n"\n' for k in range(1, 8))
     init += "".join(f'      "lea 4096(%[buf]), %%{g[1:]}\\n"\n' for g in gprs)
