@@ -6,6 +6,7 @@
 // 1e-5). Embree uses its own kernels and is held to an agreement fraction
 // instead, on the rays whose answer does not hinge on rounding.
 #include <gtest/gtest.h>
+#include "tests/test_paths.h"
 #include <tbb/parallel_for.h>
 
 #include <algorithm>

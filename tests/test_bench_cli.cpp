@@ -2,6 +2,7 @@
 // write JSON and CSV with the documented columns; bad input is answered
 // with a message and a non-zero status.
 #include <gtest/gtest.h>
+#include "tests/test_paths.h"
 #include <sys/wait.h>
 
 #include <cstdlib>

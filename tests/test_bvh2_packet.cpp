@@ -2,6 +2,7 @@
 // kernels run per lane, so hits must be identical, bit for bit, for every
 // width, every kernel variant, closest hit and occlusion.
 #include <gtest/gtest.h>
+#include "tests/test_paths.h"
 
 #include <bit>
 #include <random>

@@ -7,6 +7,7 @@
 // sphere silhouettes) and shadow rays. Then what each builder promises about
 // its tree, SAH ordering on the bunny, and the same tree for any thread count.
 #include <gtest/gtest.h>
+#include "tests/test_paths.h"
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>

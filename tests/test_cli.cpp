@@ -2,6 +2,7 @@
 // answered with a message and a non-zero status, never a crash or a
 // half-written file.
 #include <gtest/gtest.h>
+#include "tests/test_paths.h"
 #include <sys/wait.h>
 
 #include <array>

@@ -2,6 +2,7 @@
 // legend is drawn below the picture, and the CLI writes it for every
 // structure that can count.
 #include <gtest/gtest.h>
+#include "tests/test_paths.h"
 
 #include <cstdlib>
 #include <filesystem>

@@ -2,6 +2,7 @@
 // its own primitive tests, on full-resolution camera rays and shadow rays of
 // every shared scene.
 #include <gtest/gtest.h>
+#include "tests/test_paths.h"
 
 #ifdef RAYPACK_HAVE_EMBREE
 

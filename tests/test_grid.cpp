@@ -7,6 +7,7 @@
 // same primitive, another primitive only at a shared edge or vertex, and the
 // same occlusion answers.
 #include <gtest/gtest.h>
+#include "tests/test_paths.h"
 #include <tbb/parallel_for.h>
 
 #include <algorithm>

@@ -5,6 +5,7 @@
 // primitive only at a shared edge or vertex, and the same occlusion answers;
 // packets of every width must equal single rays bit for bit.
 #include <gtest/gtest.h>
+#include "tests/test_paths.h"
 #include <tbb/parallel_for.h>
 
 #include <algorithm>

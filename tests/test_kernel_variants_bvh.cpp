@@ -14,6 +14,7 @@
 // (e) far from the origin, --precision double gives t closer to the double
 //     oracle than float does (max error in float ulps).
 #include <gtest/gtest.h>
+#include "tests/test_paths.h"
 
 #include <algorithm>
 #include <bit>

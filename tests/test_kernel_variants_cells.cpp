@@ -12,6 +12,7 @@
 //   root box's faces), so that a change of behaviour shows.
 // - Robust slabs with the watertight triangle test lose no hit on them.
 #include <gtest/gtest.h>
+#include "tests/test_paths.h"
 #include <tbb/parallel_for.h>
 
 #include <array>

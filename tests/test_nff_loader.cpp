@@ -1,6 +1,7 @@
 // The NFF loader against the shipped SPD scenes (counts from scenes/SOURCES.md)
 // and against small hand-written files, good and bad.
 #include <gtest/gtest.h>
+#include "tests/test_paths.h"
 
 #include <filesystem>
 #include <fstream>

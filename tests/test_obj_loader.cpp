@@ -1,6 +1,7 @@
 // The OBJ loader: the Stanford bunny from scenes/, small hand-written meshes,
 // the camera it makes up, and its errors.
 #include <gtest/gtest.h>
+#include "tests/test_paths.h"
 
 #include <cmath>
 #include <filesystem>

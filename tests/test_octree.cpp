@@ -7,6 +7,7 @@
 // along the cube's midplanes at several depths, through node corners, from
 // inside leaves and on node boundaries, axis-parallel with +-0 components.
 #include <gtest/gtest.h>
+#include "tests/test_paths.h"
 #include <tbb/parallel_for.h>
 
 #include <algorithm>

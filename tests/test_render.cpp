@@ -1,6 +1,7 @@
 // Whitted renderer: pixels whose answer is known analytically, and the ray
 // statistics of the SPD Readme.
 #include <gtest/gtest.h>
+#include "tests/test_paths.h"
 
 #include <cmath>
 #include <filesystem>

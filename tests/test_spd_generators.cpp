@@ -1,6 +1,7 @@
 // The SPD generators against the reference NFF files in scenes/, which are
 // the unmodified output of Eric Haines' SPD 3.14 programs.
 #include <gtest/gtest.h>
+#include "tests/test_paths.h"
 
 #include <algorithm>
 #include <cctype>

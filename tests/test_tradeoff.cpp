@@ -5,6 +5,7 @@
 // every family (triangle, sphere, slabs, rcp, precision, builder, offset)
 // and writes every documented column.
 #include <gtest/gtest.h>
+#include "tests/test_paths.h"
 #include <sys/wait.h>
 
 #include <cstdio>

@@ -1,6 +1,7 @@
 // Polygon triangulation: counts, winding, and that the triangles tile the
 // polygon exactly (areas add up, none is inverted, none lies outside).
 #include <gtest/gtest.h>
+#include "tests/test_paths.h"
 
 #include <array>
 #include <cmath>

@@ -9,6 +9,7 @@
 // boxes with directions parallel to them, rays aimed exactly at mesh
 // vertices and at points of edges, rays grazing spheres), plus shadow rays.
 #include <gtest/gtest.h>
+#include "tests/test_paths.h"
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 

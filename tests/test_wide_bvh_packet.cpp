@@ -13,6 +13,7 @@
 // accepted if the single-ray traversal gives the very same answer (those
 // cases, hits outside the primitive's own box, are test_wide_bvh.cpp's).
 #include <gtest/gtest.h>
+#include "tests/test_paths.h"
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
