@@ -11,7 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "render/ray_sets.h"
+#include "measure/ray_sets.h"
 #include "scene/ray_file.h"
 
 namespace raypack::app {

@@ -18,7 +18,7 @@ struct BenchRays {
     std::vector<Rayf> rays;
 };
 
-/// The standard sets of render/ray_sets.h at w x h (diffuse: seed 1), secondary
+/// The standard sets of measure/ray_sets.h at w x h (diffuse: seed 1), secondary
 /// origins moved off the surface by `offset`.
 BenchRays make_bench_rays(const Scene& scene, const std::string& kind, int width, int height,
                           OffsetPolicy offset = kDefaultOffset);

@@ -14,7 +14,7 @@
 #include "app/bench_measure.h"
 #include "app/bench_tradeoff_report.h"
 #include "render/camera_rays.h"
-#include "render/ray_sets.h"
+#include "measure/ray_sets.h"
 #include "render/surface.h"
 #include "scene/load.h"
 

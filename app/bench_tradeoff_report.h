@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "render/accuracy_measures.h"
+#include "measure/accuracy_measures.h"
 
 namespace raypack::app {
 

@@ -5,7 +5,7 @@
 #include "app/commands.h"
 #include "app/variant_options.h"
 #include "render/camera_rays.h"
-#include "render/ray_sets.h"
+#include "measure/ray_sets.h"
 #include "scene/load.h"
 #include "scene/ray_file.h"
 

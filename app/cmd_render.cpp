@@ -7,7 +7,7 @@
 #include "app/default_config.h"
 #include "app/commands.h"
 #include "app/variant_options.h"
-#include "render/cost_map.h"
+#include "measure/cost_map.h"
 #include "render/whitted.h"
 #include "scene/load.h"
 

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "accel/accel.h"
-#include "render/ray_sets.h"
+#include "measure/ray_sets.h"
 #include "scene/load.h"
 
 namespace raypack {

@@ -19,7 +19,7 @@
 #include "accel/accel.h"
 #include "accel/brute/brute_force.h"
 #include "accel/bvh/wide_bvh_accel.h"
-#include "render/ray_sets.h"
+#include "measure/ray_sets.h"
 #include "scene/load.h"
 
 namespace raypack {

@@ -8,7 +8,7 @@
 #include <random>
 
 #include "accel/accel.h"
-#include "render/ray_sets.h"
+#include "measure/ray_sets.h"
 #include "scene/load.h"
 
 namespace raypack {

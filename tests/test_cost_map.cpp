@@ -8,8 +8,8 @@
 #include <filesystem>
 
 #include "accel/accel.h"
-#include "render/colormap.h"
-#include "render/cost_map.h"
+#include "measure/colormap.h"
+#include "measure/cost_map.h"
 #include "scene/load.h"
 
 namespace raypack {

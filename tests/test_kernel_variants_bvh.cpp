@@ -26,7 +26,7 @@
 
 #include "accel/accel.h"
 #include "accel/brute/brute_force.h"
-#include "render/ray_sets.h"
+#include "measure/ray_sets.h"
 #include "scene/load.h"
 #include "tests/oracle_harness.h"
 

@@ -7,10 +7,10 @@
 #include <cmath>
 
 #include "accel/accel.h"
-#include "render/accuracy_measures.h"
-#include "render/closed_meshes.h"
+#include "measure/accuracy_measures.h"
+#include "measure/closed_meshes.h"
 #include "render/ray_offset.h"
-#include "render/ray_sets.h"
+#include "measure/ray_sets.h"
 
 namespace raypack {
 namespace {

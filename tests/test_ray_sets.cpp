@@ -8,7 +8,7 @@
 #include <cstring>
 
 #include "accel/accel.h"
-#include "render/ray_sets.h"
+#include "measure/ray_sets.h"
 #include "render/surface.h"
 #include "scene/load.h"
 

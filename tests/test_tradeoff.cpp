@@ -1,4 +1,4 @@
-// The accuracy measures of `raypack bench --tradeoff` (render/accuracy_measures.h)
+// The accuracy measures of `raypack bench --tradeoff` (measure/accuracy_measures.h)
 // and the bench itself: the watertight test leaks nowhere on a million rays
 // at shared edges and vertices, the measures tell a leaking kernel from a
 // tight one, double-precision tests round t once, and the quick run covers
@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "accel/accel.h"
-#include "render/accuracy_measures.h"
-#include "render/closed_meshes.h"
+#include "measure/accuracy_measures.h"
+#include "measure/closed_meshes.h"
 
 namespace raypack {
 namespace {

@@ -10,7 +10,7 @@
 #include "tests/oracle_harness.h"
 #include "accel/accel.h"
 #include "render/camera_rays.h"
-#include "render/ray_sets.h"
+#include "measure/ray_sets.h"
 #include "scene/load.h"
 
 namespace raypack {

@@ -27,7 +27,7 @@
 
 #include "accel/brute/brute_force.h"
 #include "accel/bvh/wide_bvh_accel.h"
-#include "render/ray_sets.h"
+#include "measure/ray_sets.h"
 #include "scene/load.h"
 #include "tests/oracle_harness.h"
 

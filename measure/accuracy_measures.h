@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "accel/accel.h"
-#include "render/closed_meshes.h"
+#include "measure/closed_meshes.h"
 #include "render/image.h"
 #include "render/ray_offset.h"
 #include "render/whitted.h"

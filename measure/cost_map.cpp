@@ -1,4 +1,4 @@
-#include "render/cost_map.h"
+#include "measure/cost_map.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -7,9 +7,9 @@
 #include <atomic>
 #include <stdexcept>
 
-#include "render/colormap.h"
-#include "render/digit_font.h"
-#include "render/ray_sets.h"
+#include "measure/colormap.h"
+#include "measure/digit_font.h"
+#include "measure/ray_sets.h"
 
 namespace raypack {
 namespace {

@@ -1,4 +1,4 @@
-#include "render/accuracy_measures.h"
+#include "measure/accuracy_measures.h"
 
 #include <tbb/parallel_for.h>
 
@@ -13,7 +13,7 @@
 
 #include "accel/brute/brute_force.h"
 #include "render/camera_rays.h"
-#include "render/ray_sets.h"
+#include "measure/ray_sets.h"
 #include "render/surface.h"
 
 namespace raypack {

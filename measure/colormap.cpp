@@ -1,4 +1,4 @@
-#include "render/colormap.h"
+#include "measure/colormap.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "render/digit_font.h"
+#include "measure/digit_font.h"
 
 namespace raypack {
 namespace {

@@ -1,4 +1,4 @@
-#include "render/closed_meshes.h"
+#include "measure/closed_meshes.h"
 
 #include <algorithm>
 #include <cmath>

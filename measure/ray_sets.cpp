@@ -1,4 +1,4 @@
-#include "render/ray_sets.h"
+#include "measure/ray_sets.h"
 
 #include <tbb/parallel_for.h>
 
