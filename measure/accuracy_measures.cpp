@@ -8,12 +8,12 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
-#include <numbers>
 #include <random>
 
 #include "accel/brute/brute_force.h"
-#include "render/camera_rays.h"
 #include "measure/ray_sets.h"
+#include "render/camera_rays.h"
+#include "render/sampling.h"
 #include "render/surface.h"
 
 namespace raypack {
@@ -25,17 +25,6 @@ constexpr std::size_t kBlock = 4096;  // rays per parallel task, each with its o
 std::mt19937_64 block_generator(std::uint64_t seed, std::size_t block) {
     std::seed_seq seq{std::uint32_t(seed), std::uint32_t(seed >> 32), std::uint32_t(block), std::uint32_t(block >> 32)};
     return std::mt19937_64(seq);
-}
-
-double uniform(std::mt19937_64& g, double lo = 0, double hi = 1) {
-    return lo + (hi - lo) * double(g() >> 11) * 0x1.0p-53;
-}
-
-/// Uniform on the unit sphere (Marsaglia 1972 in its cylinder form).
-Vec3d random_unit(std::mt19937_64& g) {
-    const double z = uniform(g, -1, 1), phi = uniform(g, 0, 2 * std::numbers::pi);
-    const double r = std::sqrt(std::max(0.0, 1 - z * z));
-    return {r * std::cos(phi), r * std::sin(phi), z};
 }
 
 Vec3f to_float(const Vec3d& v) { return {float(v.x), float(v.y), float(v.z)}; }
@@ -168,7 +157,7 @@ LeakCounts count_mesh_leaks(const ObjectScene& meshes, const Accel& accel, std::
             // An interior point: the centroid moved by up to a fifth of the
             // mesh's size (the meshes are convex and at least that thick).
             const Vec3f inner = meshes.centroid[index.object[m]] +
-                                to_float(random_unit(g)) * (index.size[m] * float(uniform(g, 0, 0.2)));
+                                to_float(uniform_sphere(g)) * (index.size[m] * float(uniform(g, 0, 0.2)));
             Rayf ray;
             if (aim == Inside) {
                 ray.org = inner;
@@ -227,7 +216,7 @@ LeakCounts count_sphere_leaks(const ObjectScene& spheres, const Accel& accel, st
             Vec3f org = s.center[i];
             for (int attempt = 0; attempt < 8; ++attempt) {
                 const double depth = std::ldexp(1.0, -int(uniform(g, 1, 21)));
-                const Vec3f candidate = to_float(c + random_unit(g) * (radius * (1 - depth)));
+                const Vec3f candidate = to_float(c + uniform_sphere(g) * (radius * (1 - depth)));
                 if (length(Vec3d(candidate) - c) < radius) {
                     org = candidate;
                     break;
@@ -235,7 +224,7 @@ LeakCounts count_sphere_leaks(const ObjectScene& spheres, const Accel& accel, st
             }
             Rayf ray;
             ray.org = org;
-            ray.dir = to_float(random_unit(g));
+            ray.dir = to_float(uniform_sphere(g));
             rays.push_back(ray);
         }
         std::vector<Hitf> hits(rays.size());
@@ -279,11 +268,11 @@ UlpError t_error_ulps(const Scene& scene, PrimKind kind, KernelChoice kernels, s
                 size = scene.spheres.radius[i];
                 target = centre;
             }
-            const Vec3d w = random_unit(g);
+            const Vec3d w = uniform_sphere(g);
             const Vec3d org = target + w * (size * std::pow(10.0, uniform(g, std::log10(2.0), 4)));
             if (kind == PrimKind::Sphere) {
                 // A point of the disc the sphere shows toward the origin.
-                Vec3d d = random_unit(g);
+                Vec3d d = uniform_sphere(g);
                 d = d - w * dot(d, w);
                 if (length(d) > 0) target = centre + d * (size * 0.99 * std::sqrt(uniform(g)) / length(d));
             }

@@ -3,11 +3,10 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <cmath>
-#include <numbers>
 
 #include "accel/accel.h"
 #include "render/camera_rays.h"
+#include "render/sampling.h"
 #include "render/surface.h"
 
 namespace raypack {
@@ -30,35 +29,6 @@ Vec3f offset_origin(const Scene& scene, const RayOffset& offset, const Rayf& ray
                     const Surface& s) {
     const Vec3f n = dot(s.geometric_normal, ray.dir) < 0 ? s.geometric_normal : -s.geometric_normal;
     return offset.offset(offset.hit_point(scene, ray, hit, s.point), n);
-}
-
-/// SplitMix64 (Steele, Lea, Flood, OOPSLA 2014): a counter-based generator,
-/// so each pixel's numbers depend on (seed, pixel) alone.
-std::uint64_t splitmix64(std::uint64_t& state) {
-    std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-
-float uniform01(std::uint64_t& state) { return float(splitmix64(state) >> 40) * 0x1.0p-24f; }
-
-/// Malley's method: uniform on the unit disk (polar mapping), lifted to the
-/// hemisphere about +z; the density is cos(theta) / pi.
-Vec3f cosine_hemisphere(float u1, float u2) {
-    const float r = std::sqrt(u1), phi = 2.0f * std::numbers::pi_v<float> * u2;
-    const float x = r * std::cos(phi), y = r * std::sin(phi);
-    return {x, y, std::sqrt(std::max(0.0f, 1.0f - x * x - y * y))};
-}
-
-/// An orthonormal frame about unit n (Duff et al., "Building an Orthonormal
-/// Basis, Revisited", JCGT 2017), applied to a local direction.
-Vec3f to_world(const Vec3f& n, const Vec3f& local) {
-    const float sign = std::copysign(1.0f, n.z);
-    const float a = -1.0f / (sign + n.z), b = n.x * n.y * a;
-    const Vec3f t(1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x);
-    const Vec3f bt(b, sign + n.y * n.y * a, -n.y);
-    return t * local.x + bt * local.y + n * local.z;
 }
 
 }  // namespace
@@ -105,7 +75,7 @@ std::vector<Rayf> diffuse_ray_set(const Scene& scene, int width, int height, std
         const float u1 = uniform01(state), u2 = uniform01(state);
         Rayf r;
         r.org = offset_origin(scene, offset, camera[i], hits[i], s);
-        r.dir = to_world(n, cosine_hemisphere(u1, u2));
+        r.dir = OrthonormalBasis(n).to_world(cosine_hemisphere(u1, u2));
         r.tnear = offset.tnear();
         rays.push_back(r);
     }

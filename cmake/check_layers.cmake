@@ -1,0 +1,21 @@
+cmake_minimum_required(VERSION 3.25)
+# Fails when a file of layer LAYER includes a raypack header from a folder
+# outside ALLOWED (the layer itself and those below it); writes STAMP when all
+# is well. Called by the build (CMakeLists.txt, "One library per layer").
+set(bad "")
+foreach(file IN LISTS FILES)
+  file(STRINGS ${file} includes REGEX "^[ \t]*#[ \t]*include[ \t]*\"[a-z_]+/")
+  foreach(line IN LISTS includes)
+    string(REGEX REPLACE "^[^\"]*\"([a-z_]+)/.*$" "\\1" top "${line}")
+    if(NOT top IN_LIST ALLOWED)
+      file(RELATIVE_PATH rel ${SOURCE_DIR} ${file})
+      string(STRIP "${line}" line)
+      list(APPEND bad "${rel}: ${line} (layer ${LAYER} may use: ${ALLOWED})")
+    endif()
+  endforeach()
+endforeach()
+if(bad)
+  list(JOIN bad "\n  " text)
+  message(FATAL_ERROR "include across layers:\n  ${text}")
+endif()
+file(WRITE ${STAMP} "")

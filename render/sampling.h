@@ -1,0 +1,76 @@
+#pragma once
+// Sampling helpers shared by the renderer and the measuring harness: random
+// numbers, warps from the unit square, and an orthonormal frame.
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <numbers>
+
+#include "kernels/vec3.h"
+
+namespace raypack {
+
+/// SplitMix64 (Steele, Lea, Flood, OOPSLA 2014): a counter-based generator,
+/// so each pixel's numbers depend on (seed, pixel) alone.
+inline std::uint64_t splitmix64(std::uint64_t& state) {
+    std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+/// A float uniform in [0, 1) from the top 24 bits of the next SplitMix64 draw.
+inline float uniform01(std::uint64_t& state) { return float(splitmix64(state) >> 40) * 0x1.0p-24f; }
+
+/// A double uniform in [lo, hi) from the top 53 bits of a 64-bit generator's draw.
+template <class Generator>
+double uniform(Generator& g, double lo = 0, double hi = 1) {
+    return lo + (hi - lo) * double(g() >> 11) * 0x1.0p-53;
+}
+
+/// Uniform on the unit sphere (Marsaglia 1972 in its cylinder form).
+template <class Generator>
+Vec3d uniform_sphere(Generator& g) {
+    const double z = uniform(g, -1, 1), phi = uniform(g, 0, 2 * std::numbers::pi);
+    const double r = std::sqrt(std::max(0.0, 1 - z * z));
+    return {r * std::cos(phi), r * std::sin(phi), z};
+}
+
+/// A point of the unit square mapped uniformly onto the unit disk by the polar
+/// map (r = sqrt(u1), phi = 2 pi u2); z is 0.
+template <class T>
+Vec3<T> uniform_disk_polar(T u1, T u2) {
+    const T r = std::sqrt(u1), phi = T(2) * std::numbers::pi_v<T> * u2;
+    return {r * std::cos(phi), r * std::sin(phi), T(0)};
+}
+
+/// Malley's method: uniform on the unit disk, lifted to the hemisphere about
+/// +z; the density is cos(theta) / pi (Pharr, Jakob, Humphreys, pbrt 4th ed.,
+/// section A.5.3).
+template <class T>
+Vec3<T> cosine_hemisphere(T u1, T u2) {
+    const Vec3<T> d = uniform_disk_polar(u1, u2);
+    return {d.x, d.y, std::sqrt(std::max(T(0), T(1) - d.x * d.x - d.y * d.y))};
+}
+
+/// An orthonormal frame (t, b, n) about unit n (Duff et al., "Building an
+/// Orthonormal Basis, Revisited", JCGT 2017).
+template <class T>
+struct OrthonormalBasis {
+    Vec3<T> t, b, n;
+
+    explicit OrthonormalBasis(const Vec3<T>& unit_n) : n(unit_n) {
+        const T sign = std::copysign(T(1), n.z);
+        const T a = T(-1) / (sign + n.z), c = n.x * n.y * a;
+        t = Vec3<T>(T(1) + sign * n.x * n.x * a, sign * c, -sign * n.x);
+        b = Vec3<T>(c, sign + n.y * n.y * a, -n.y);
+    }
+
+    /// A direction given in the frame's coordinates, in world coordinates.
+    Vec3<T> to_world(const Vec3<T>& local) const { return t * local.x + b * local.y + n * local.z; }
+    /// A world direction in the frame's coordinates.
+    Vec3<T> to_local(const Vec3<T>& world) const { return {dot(world, t), dot(world, b), dot(world, n)}; }
+};
+
+}  // namespace raypack
