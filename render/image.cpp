@@ -1,44 +1,104 @@
 #include "render/image.h"
 
-#include <OpenImageIO/imageio.h>
+#include <dlfcn.h>
+#include <unistd.h>
 
-#include <algorithm>
+#include <array>
+#include <cstdlib>
+#include <filesystem>
+#include <future>
+#include <mutex>
 #include <stdexcept>
 
+#include "render/image_module.h"
 #include "scene/atomic_file.h"
 
 namespace raypack {
+namespace {
+
+/// The loaded module, or why it could not be loaded.
+struct LoadedModule {
+    const RaypackImageModule* module = nullptr;
+    std::string error;
+};
+
+/// The directory of the running executable, or "" if /proc does not say.
+std::string executable_dir() {
+    std::array<char, 4096> buf{};
+    const ssize_t n = readlink("/proc/self/exe", buf.data(), buf.size() - 1);
+    if (n <= 0) return {};
+    return std::filesystem::path(std::string(buf.data(), std::size_t(n))).parent_path().string();
+}
+
+/// `where` says how `path` was chosen, for the error message.
+LoadedModule open_module(const std::string& path, const std::string& where) {
+    // RTLD_NOW: an unresolved symbol is an error here, not a crash later.
+    void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+    if (!handle) return {nullptr, "cannot load the image module " + path + " (" + where + "): " + dlerror()};
+    const auto* module = static_cast<const RaypackImageModule*>(dlsym(handle, kRaypackImageModuleSymbol));
+    if (!module) return {nullptr, "image module " + path + ": " + dlerror()};
+    if (module->version != kRaypackImageModuleVersion)
+        return {nullptr, "image module " + path + ": interface version " + std::to_string(module->version) +
+                             ", this raypack expects " + std::to_string(kRaypackImageModuleVersion)};
+    return {module, {}};
+}
+
+/// The search rule: $RAYPACK_IMAGE_MODULE if set (a path to the file), else
+/// libraypack_image.so next to the executable, else the dynamic loader's
+/// search (the executable's RUNPATH, which the build sets to the build
+/// directory, then LD_LIBRARY_PATH and the system directories).
+LoadedModule load_module() {
+    if (const char* env = std::getenv("RAYPACK_IMAGE_MODULE"); env && *env) return open_module(env, "from RAYPACK_IMAGE_MODULE");
+    const std::string dir = executable_dir();
+    if (!dir.empty()) {
+        const std::string beside = dir + "/" + kImageModuleFile;
+        std::error_code ec;
+        if (std::filesystem::exists(beside, ec)) return open_module(beside, "next to the executable");
+    }
+    return open_module(kImageModuleFile, "not next to the executable " + (dir.empty() ? "?" : dir) +
+                                            "; searched the RUNPATH, LD_LIBRARY_PATH and system directories");
+}
+
+std::once_flag g_started;
+std::shared_future<LoadedModule> g_loaded;
+
+/// The module, loading it (or waiting for the background load) on first use.
+const RaypackImageModule& image_module() {
+    start_loading_image_module();
+    const LoadedModule& loaded = g_loaded.get();
+    if (!loaded.module) throw std::runtime_error(loaded.error);
+    return *loaded.module;
+}
+
+}  // namespace
+
+void start_loading_image_module() {
+    std::call_once(g_started, [] { g_loaded = std::async(std::launch::async, load_module).share(); });
+}
 
 void write_image(const std::string& path, const Image& image) {
+    const RaypackImageModule& module = image_module();
+    std::array<char, 1024> error{};
     // Fail before touching the file system when the format is unknown.
-    if (!OIIO::ImageOutput::create(path))
-        throw std::runtime_error(path + ": no image writer for this file extension (" + OIIO::geterror() + ")");
+    if (module.check_writer(path.c_str(), error.data(), error.size()) != 0)
+        throw std::runtime_error(path + ": " + error.data());
     write_atomically(path, [&](const std::string& tmp) {
-        auto out = OIIO::ImageOutput::create(tmp);
-        if (!out) throw std::runtime_error(path + ": " + OIIO::geterror());
-        const bool is_exr = std::string(out->format_name()) == "openexr";
-        const OIIO::TypeDesc type = is_exr ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::UINT8;
-        OIIO::ImageSpec spec(image.width, image.height, 3, type);
-        if (!out->open(tmp, spec)) throw std::runtime_error(path + ": " + out->geterror());
-        std::vector<float> pixels = image.rgb;
-        if (!is_exr)
-            for (float& v : pixels) v = std::clamp(v, 0.0f, 1.0f);
-        if (!out->write_image(OIIO::TypeDesc::FLOAT, pixels.data()) || !out->close())
-            throw std::runtime_error(path + ": " + out->geterror());
+        if (module.write_rgb(tmp.c_str(), image.width, image.height, image.rgb.data(), error.data(), error.size()) != 0)
+            throw std::runtime_error(path + ": " + error.data());
     });
 }
 
 Image read_image(const std::string& path) {
-    auto in = OIIO::ImageInput::open(path);
-    if (!in) throw std::runtime_error(path + ": cannot read image (" + OIIO::geterror() + ")");
-    const OIIO::ImageSpec& spec = in->spec();
-    Image image(spec.width, spec.height);
-    std::vector<float> all(std::size_t(spec.width) * std::size_t(spec.height) * std::size_t(spec.nchannels));
-    if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data()))
-        throw std::runtime_error(path + ": " + in->geterror());
-    for (std::size_t p = 0; p < std::size_t(spec.width) * std::size_t(spec.height); ++p)
-        for (int c = 0; c < 3; ++c)
-            image.rgb[p * 3 + std::size_t(c)] = all[p * std::size_t(spec.nchannels) + std::size_t(std::min(c, spec.nchannels - 1))];
+    const RaypackImageModule& module = image_module();
+    std::array<char, 1024> error{};
+    Image image;
+    const auto allocate = [](void* context, int width, int height) {
+        Image& target = *static_cast<Image*>(context);
+        target = Image(width, height);
+        return target.rgb.data();
+    };
+    if (module.read_rgb(path.c_str(), &image, allocate, error.data(), error.size()) != 0)
+        throw std::runtime_error(path + ": " + error.data());
     return image;
 }
 

@@ -1,5 +1,6 @@
 #pragma once
-// A linear RGB float image and its output through OpenImageIO.
+// A linear RGB float image, and its reading and writing through the image
+// module (OpenImageIO, loaded when first needed: render/image_module.h).
 #include <string>
 #include <vector>
 
@@ -25,9 +26,18 @@ struct Image {
     }
 };
 
+/// Starts loading the image module in a background thread, so that a command
+/// that will write an image does not wait for it before its work; the first
+/// write_image / read_image waits for the load. Calling it again does nothing.
+/// Call it once the command is past its likely errors: a process that exits
+/// while the module is still loading runs the destructors of the libraries
+/// loaded so far while the loader thread still runs their constructors.
+void start_loading_image_module();
+
 /// Writes the image in the format its extension names (.png, .exr, .tif,
 /// .jpg, .ppm, ...), 8-bit formats clamped to [0, 1]. Written to a temporary
-/// file and renamed. Throws std::runtime_error naming the file on failure.
+/// file and renamed. Throws std::runtime_error naming the file on failure,
+/// or naming the module and the loader's reason when it cannot be loaded.
 void write_image(const std::string& path, const Image& image);
 
 /// Reads any image OpenImageIO reads, as linear RGB floats (for tests and tools).
