@@ -91,7 +91,7 @@ int run_render(const Args& args) {
     if (aov == "cost") return render_cost(scene, *accel, options.width, options.height, output);
     options.packet = fastest ? supported_packet(*accel, fastest_config(RayWorkload::Camera).packet)
                              : packet_width_from(p, *accel);
-    start_loading_image_module();  // past the likely errors: OpenImageIO loads while the scene renders
+    start_loading_image_module(output);  // past the likely errors: the image module loads while tracing
     Image image;
     const RenderStats stats = render_whitted(scene, *accel, options, image);
     t0 = std::chrono::steady_clock::now();

@@ -1,6 +1,7 @@
 #include "render/image.h"
 
 #include <dlfcn.h>
+#include <strings.h>
 #include <unistd.h>
 
 #include <array>
@@ -16,11 +17,29 @@
 namespace raypack {
 namespace {
 
-/// The loaded module, or why it could not be loaded.
+/// A loaded module, or why it could not be loaded.
 struct LoadedModule {
     const RaypackImageModule* module = nullptr;
     std::string error;
 };
+
+/// One image module: its file, the variable that overrides where it is, and
+/// its load, started once.
+struct ModuleSlot {
+    const char* file;
+    const char* env;
+    std::once_flag started;
+    std::shared_future<LoadedModule> loaded;
+};
+
+ModuleSlot g_oiio{"libraypack_image.so", "RAYPACK_IMAGE_MODULE", {}, {}};
+ModuleSlot g_png{"libraypack_png.so", "RAYPACK_PNG_MODULE", {}, {}};
+
+/// PNG goes to the small libpng module; everything else to OpenImageIO.
+ModuleSlot& writer_slot(const std::string& path) {
+    const std::size_t n = path.size();
+    return n >= 4 && strcasecmp(path.c_str() + n - 4, ".png") == 0 ? g_png : g_oiio;
+}
 
 /// The directory of the running executable, or "" if /proc does not say.
 std::string executable_dir() {
@@ -43,41 +62,42 @@ LoadedModule open_module(const std::string& path, const std::string& where) {
     return {module, {}};
 }
 
-/// The search rule: $RAYPACK_IMAGE_MODULE if set (a path to the file), else
-/// libraypack_image.so next to the executable, else the dynamic loader's
-/// search (the executable's RUNPATH, which the build sets to the build
-/// directory, then LD_LIBRARY_PATH and the system directories).
-LoadedModule load_module() {
-    if (const char* env = std::getenv("RAYPACK_IMAGE_MODULE"); env && *env) return open_module(env, "from RAYPACK_IMAGE_MODULE");
+/// The search rule: the module's variable (RAYPACK_IMAGE_MODULE,
+/// RAYPACK_PNG_MODULE) if set, a path to the file; else the file next to the
+/// executable; else the dynamic loader's search (the executable's RUNPATH,
+/// which the build sets to the build directory, then LD_LIBRARY_PATH and the
+/// system directories).
+LoadedModule load_module(const ModuleSlot& slot) {
+    if (const char* env = std::getenv(slot.env); env && *env) return open_module(env, std::string("from ") + slot.env);
     const std::string dir = executable_dir();
     if (!dir.empty()) {
-        const std::string beside = dir + "/" + kImageModuleFile;
+        const std::string beside = dir + "/" + slot.file;
         std::error_code ec;
         if (std::filesystem::exists(beside, ec)) return open_module(beside, "next to the executable");
     }
-    return open_module(kImageModuleFile, "not next to the executable " + (dir.empty() ? "?" : dir) +
-                                            "; searched the RUNPATH, LD_LIBRARY_PATH and system directories");
+    return open_module(slot.file, "not next to the executable " + (dir.empty() ? "?" : dir) +
+                                      "; searched the RUNPATH, LD_LIBRARY_PATH and system directories");
 }
 
-std::once_flag g_started;
-std::shared_future<LoadedModule> g_loaded;
+void start_loading(ModuleSlot& slot) {
+    std::call_once(slot.started,
+                   [&slot] { slot.loaded = std::async(std::launch::async, load_module, std::cref(slot)).share(); });
+}
 
 /// The module, loading it (or waiting for the background load) on first use.
-const RaypackImageModule& image_module() {
-    start_loading_image_module();
-    const LoadedModule& loaded = g_loaded.get();
+const RaypackImageModule& module_of(ModuleSlot& slot) {
+    start_loading(slot);
+    const LoadedModule& loaded = slot.loaded.get();
     if (!loaded.module) throw std::runtime_error(loaded.error);
     return *loaded.module;
 }
 
 }  // namespace
 
-void start_loading_image_module() {
-    std::call_once(g_started, [] { g_loaded = std::async(std::launch::async, load_module).share(); });
-}
+void start_loading_image_module(const std::string& path_to_write) { start_loading(writer_slot(path_to_write)); }
 
 void write_image(const std::string& path, const Image& image) {
-    const RaypackImageModule& module = image_module();
+    const RaypackImageModule& module = module_of(writer_slot(path));
     std::array<char, 1024> error{};
     // Fail before touching the file system when the format is unknown.
     if (module.check_writer(path.c_str(), error.data(), error.size()) != 0)
@@ -89,7 +109,7 @@ void write_image(const std::string& path, const Image& image) {
 }
 
 Image read_image(const std::string& path) {
-    const RaypackImageModule& module = image_module();
+    const RaypackImageModule& module = module_of(g_oiio);
     std::array<char, 1024> error{};
     Image image;
     const auto allocate = [](void* context, int width, int height) {

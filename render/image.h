@@ -26,21 +26,23 @@ struct Image {
     }
 };
 
-/// Starts loading the image module in a background thread, so that a command
-/// that will write an image does not wait for it before its work; the first
-/// write_image / read_image waits for the load. Calling it again does nothing.
-/// Call it once the command is past its likely errors: a process that exits
-/// while the module is still loading runs the destructors of the libraries
-/// loaded so far while the loader thread still runs their constructors.
-void start_loading_image_module();
+/// Starts loading, in a background thread, the image module that will write
+/// `path_to_write` (libpng for .png, OpenImageIO otherwise), so that a command
+/// does not wait for it before its work; write_image waits for the load.
+/// Calling it again does nothing. Call it once the command is past its likely
+/// errors: a process that exits while a module is still loading runs the
+/// destructors of the libraries loaded so far while the loader thread still
+/// runs their constructors.
+void start_loading_image_module(const std::string& path_to_write);
 
-/// Writes the image in the format its extension names (.png, .exr, .tif,
-/// .jpg, .ppm, ...), 8-bit formats clamped to [0, 1]. Written to a temporary
+/// Writes the image in the format its extension names (.png through libpng;
+/// .exr, .tif, .jpg, .ppm, ... through OpenImageIO), 8-bit formats clamped to
+/// [0, 1] and rounded as OpenImageIO rounds. Written to a temporary
 /// file and renamed. Throws std::runtime_error naming the file on failure,
 /// or naming the module and the loader's reason when it cannot be loaded.
 void write_image(const std::string& path, const Image& image);
 
-/// Reads any image OpenImageIO reads, as linear RGB floats (for tests and tools).
+/// Reads any image OpenImageIO reads (through its module), as linear RGB floats (for tests and tools).
 Image read_image(const std::string& path);
 
 }  // namespace raypack

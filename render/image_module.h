@@ -1,7 +1,8 @@
 #pragma once
-// The interface between raypack and its image module, libraypack_image.so
-// (imageio/oiio_image_module.cpp), which reads and writes images through
-// OpenImageIO. OpenImageIO pulls in about 260 shared libraries whose symbols
+// The interface between raypack and its image modules: libraypack_image.so
+// (imageio/oiio_image_module.cpp) reads and writes images through
+// OpenImageIO; libraypack_png.so (imageio/png_image_module.cpp) writes PNG
+// through libpng alone. OpenImageIO pulls in about 260 shared libraries whose symbols
 // are bound at load; keeping them in a module loaded with dlopen when an image
 // is first needed keeps them out of every command that writes no image.
 // Plain C types only, so that the loader and the module agree without sharing
@@ -26,6 +27,7 @@ struct RaypackImageModule {
     int (*write_rgb)(const char* path, int width, int height, const float* rgb, char* error, std::size_t error_size);
     /// Reads `path` as linear RGB floats into the buffer that
     /// allocate(context, width, height) returns (width * height * 3 floats).
+    /// Null in a module that only writes.
     int (*read_rgb)(const char* path, void* context, float* (*allocate)(void* context, int width, int height),
                     char* error, std::size_t error_size);
 };
@@ -33,7 +35,6 @@ struct RaypackImageModule {
 }  // extern "C"
 
 namespace raypack {
-/// The file name the loader looks for, and the symbol it reads from it.
-inline constexpr const char* kImageModuleFile = "libraypack_image.so";
+/// The symbol the loader reads from a module.
 inline constexpr const char* kRaypackImageModuleSymbol = "raypack_image_module";
 }  // namespace raypack
