@@ -4,6 +4,7 @@
 // and every other format, stay with libraypack_image.so.
 #include <png.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -33,17 +34,45 @@ int check_writer(const char* path, char* error, std::size_t error_size) {
 /// (tests/test_image_module.cpp compares them around every rounding threshold).
 unsigned char to_byte(float v) { return static_cast<unsigned char>(std::round(std::fmin(std::fmax(v, 0.0f), 1.0f) * 255.0f)); }
 
+/// libpng reports errors by longjmp; the message is kept for the caller.
+void on_png_error(png_structp png, png_const_charp message) {
+    std::snprintf(static_cast<char*>(png_get_error_ptr(png)), 256, "libpng: %s", message);
+    png_longjmp(png, 1);
+}
+
+/// Writes 8-bit RGB rows. zlib level 1 with the Sub filter: on the seven SPD
+/// renders (512 x 512) it wrote 2-4x faster than libpng's defaults (which
+/// OpenImageIO used) for files 5-33% larger (README "Build options").
+bool write_png(std::FILE* file, int width, int height, const unsigned char* bytes, char* message) {
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, message, on_png_error, nullptr);
+    if (!png) return false;
+    png_infop info = png_create_info_struct(png);
+    if (!info || setjmp(png_jmpbuf(png))) {
+        png_destroy_write_struct(&png, &info);
+        return false;
+    }
+    png_init_io(png, file);
+    png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_set_compression_level(png, 1);
+    png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_SUB);
+    png_write_info(png, info);
+    for (int y = 0; y < height; ++y) png_write_row(png, bytes + std::size_t(y) * std::size_t(width) * 3);
+    png_write_end(png, nullptr);
+    png_destroy_write_struct(&png, &info);
+    return true;
+}
+
 int write_rgb(const char* path, int width, int height, const float* rgb, char* error, std::size_t error_size) {
     std::vector<unsigned char> bytes(std::size_t(width) * std::size_t(height) * 3);
     for (std::size_t i = 0; i < bytes.size(); ++i) bytes[i] = to_byte(rgb[i]);
-    png_image image;
-    std::memset(&image, 0, sizeof image);
-    image.version = PNG_IMAGE_VERSION;
-    image.width = png_uint_32(width);
-    image.height = png_uint_32(height);
-    image.format = PNG_FORMAT_RGB;
-    if (!png_image_write_to_file(&image, path, 0, bytes.data(), 0, nullptr))
-        return fail(std::string("libpng: ") + image.message, error, error_size);
+    std::FILE* file = std::fopen(path, "wb");
+    if (!file) return fail(std::string("cannot open for writing: ") + std::strerror(errno), error, error_size);
+    char message[256] = "libpng: unknown error";
+    const bool written = write_png(file, width, height, bytes.data(), message);
+    const bool closed = std::fclose(file) == 0;
+    if (!written) return fail(message, error, error_size);
+    if (!closed) return fail(std::string("cannot write: ") + std::strerror(errno), error, error_size);
     return 0;
 }
 
