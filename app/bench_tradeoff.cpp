@@ -15,6 +15,7 @@
 #include "app/bench_tradeoff_report.h"
 #include "render/camera_rays.h"
 #include "measure/ray_sets.h"
+#include "measure/scale_invariance.h"
 #include "render/surface.h"
 #include "scene/load.h"
 
@@ -320,6 +321,10 @@ void run_offset_family(const TradeoffPlan& plan, const TradeoffSizes& sizes, con
         for (std::size_t i = 0; i < placed.size(); ++i)
             row.self.push_back(count_self_intersections(placed[i], *placed_accels[i], policy, sizes.self_res,
                                                         sizes.self_res));
+        for (const Placement& p : placements)
+            row.placed_image.push_back(scale_invariance_error(image_scene, policy, p.scale,
+                                                              Vec3f{p.translation, p.translation, p.translation},
+                                                              sizes.image_res, sizes.image_res));
         Image image;
         render_whitted(image_scene, *build_accel(image_scene, AccelConfig{}), image_options(sizes.image_res, policy), image);
         row.image = image_error(image, reference);

@@ -57,6 +57,9 @@ Json to_json(const TradeoffRow& r) {
         j["shadow_wrong_" + label] = self ? Json(r.self[i].shadow_wrong) : Json();
         j["self_reflect_rays_" + label] = self ? Json(r.self[i].reflect_rays) : Json();
         j["self_reflect_hits_" + label] = self ? Json(r.self[i].reflect_self) : Json();
+        const bool placed = i < r.placed_image.size();
+        j["placed_psnr_db_" + label] = placed ? number_or_null(true, r.placed_image[i].psnr_db) : Json();
+        j["placed_differing_fraction_" + label] = placed ? Json(r.placed_image[i].differing_fraction) : Json();
     }
     const bool image = r.image.has_value();
     j["image_scene"] = image ? Json(r.image_scene) : Json();
@@ -135,7 +138,8 @@ void print_tradeoff_table(std::FILE* out, const std::vector<TradeoffRow>& rows) 
         if (r.self.empty()) continue;
         if (!header) {
             std::fprintf(out, "\nself-intersections (shadow + reflection rays that found the object they left), and shadow\n"
-                         "rays whose answer differs from the reference traced from the hit point itself:\n%-18s",
+                         "rays whose answer differs from the reference traced from the hit point itself; for the offsets\n"
+                         "also the image scene placed alike against itself unplaced (PSNR dB/fraction of pixels that differ):\n%-18s",
                          "");
             for (const Placement& p : self_intersection_placements()) std::fprintf(out, " %14s", placement_label(p).c_str());
             std::fprintf(out, "\n");
@@ -146,6 +150,16 @@ void print_tradeoff_table(std::FILE* out, const std::vector<TradeoffRow>& rows) 
         std::fprintf(out, "\n%-18s", "  wrong shadows");
         for (const SelfIntersections& s : r.self)
             std::fprintf(out, " %14s", fraction_text(s.shadow_wrong, s.shadow_rays).c_str());
+        std::fprintf(out, "\n");
+        if (r.placed_image.empty()) continue;
+        // The image scene placed alike against itself unplaced: PSNR dB / fraction of pixels that differ.
+        std::fprintf(out, "%-18s", "  placed image");
+        for (const ImageError& e : r.placed_image) {
+            char cell[24];
+            std::snprintf(cell, sizeof cell, "%.1f/%.3f", std::isfinite(e.psnr_db) ? e.psnr_db : 99.0,
+                          e.differing_fraction);
+            std::fprintf(out, " %14s", cell);
+        }
         std::fprintf(out, "\n");
     }
 }

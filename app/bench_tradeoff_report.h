@@ -30,6 +30,9 @@ struct TradeoffRow {
     std::optional<LeakCounts> leaks;
     std::optional<UlpError> t_ulps;
     std::vector<SelfIntersections> self;  ///< empty, or one per self_intersection_placements()
+    /// Offset rows: the image scene placed as each self_intersection_placements()
+    /// entry against the unplaced one, same policy (measure/scale_invariance.h).
+    std::vector<ImageError> placed_image;
     std::string image_scene;
     int image_width = 0, image_height = 0;
     std::optional<ImageError> image;

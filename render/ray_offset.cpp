@@ -13,10 +13,13 @@ constexpr OffsetPolicy kPolicies[] = {OffsetPolicy::Epsilon, OffsetPolicy::Scale
 float max_abs(const Vec3f& v) { return std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}); }
 
 // Waechter & Binder, "A Fast and Robust Method for Avoiding
-// Self-Intersection", Ray Tracing Gems (2019), ch. 6, listing 6-1: the
-// constants as published.
-constexpr float kOrigin = 1.0f / 32.0f;        // below this magnitude, offset in absolute terms
-constexpr float kFloatScale = 1.0f / 65536.0f;  // the absolute offset there
+// Self-Intersection", Ray Tracing Gems (2019), ch. 6, listing 6-1. The
+// published origin threshold and float offset are absolute, i.e. tuned for a
+// scene of size about 1: in a scene of size 1e-4 the 1/65536 offset jumps over
+// whole objects (issue 19). Here both are in units of the scene's extent, so
+// the method reads the same at any scale; the ULP part is relative already.
+constexpr float kOrigin = 1.0f / 32.0f;        // x extent: below this magnitude, offset in absolute terms
+constexpr float kFloatScale = 1.0f / 65536.0f;  // x extent: the absolute offset there
 constexpr float kIntScale = 256.0f;             // ULPs elsewhere
 
 /// `x` moved by `ulps` units in the last place, away from zero when ulps > 0
@@ -26,8 +29,8 @@ float add_ulps(float x, int ulps) {
     return std::bit_cast<float>(bits + (x < 0 ? -ulps : ulps));
 }
 
-float offset_coordinate(float p, float n) {
-    if (std::fabs(p) < kOrigin) return p + kFloatScale * n;
+float offset_coordinate(float p, float n, float extent) {
+    if (std::fabs(p) < kOrigin * extent) return p + kFloatScale * extent * n;
     return add_ulps(p, int(kIntScale * n));
 }
 
@@ -57,8 +60,9 @@ std::string offset_policy_list() {
     return out;
 }
 
-Vec3f offset_ray_origin_robust(const Vec3f& p, const Vec3f& n) {
-    return {offset_coordinate(p.x, n.x), offset_coordinate(p.y, n.y), offset_coordinate(p.z, n.z)};
+Vec3f offset_ray_origin_robust(const Vec3f& p, const Vec3f& n, float scene_extent) {
+    return {offset_coordinate(p.x, n.x, scene_extent), offset_coordinate(p.y, n.y, scene_extent),
+            offset_coordinate(p.z, n.z, scene_extent)};
 }
 
 Vec3f accurate_hit_point(const Scene& scene, const Rayf& ray, const Hitf& hit) {
@@ -91,7 +95,7 @@ Vec3f RayOffset::offset(const Vec3f& p, const Vec3f& n) const {
     switch (policy_) {
         case OffsetPolicy::Epsilon: return p + n * 1e-4f;
         case OffsetPolicy::Scaled: return p + n * (1e-4f * std::max(max_abs(p), 1e-3f * scene_extent_));
-        case OffsetPolicy::Robust: return offset_ray_origin_robust(p, n);
+        case OffsetPolicy::Robust: return offset_ray_origin_robust(p, n, scene_extent_);
     }
     return p;
 }

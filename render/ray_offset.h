@@ -15,7 +15,8 @@ namespace raypack {
 enum class OffsetPolicy {
     Epsilon,  ///< a fixed 1e-4 along the normal, whatever the scene's size
     Scaled,   ///< 1e-4 x max(|p|, 1e-3 x scene extent): relative to the magnitude
-    Robust,   ///< Waechter & Binder, Ray Tracing Gems ch. 6: 256 ULPs of each coordinate
+    Robust,   ///< Waechter & Binder, Ray Tracing Gems ch. 6: 256 ULPs of each coordinate,
+              ///< near the origin thresholds in units of the scene extent
 };
 
 /// What render, rays and bench use without --offset.
@@ -36,7 +37,7 @@ Vec3f accurate_hit_point(const Scene& scene, const Rayf& ray, const Hitf& hit);
 /// Moves secondary-ray origins off surfaces by one policy.
 class RayOffset {
 public:
-    /// `scene_extent`: the diagonal of the scene's bounds (Scaled only).
+    /// `scene_extent`: the diagonal of the scene's bounds (Scaled and Robust).
     RayOffset(OffsetPolicy policy, float scene_extent) : policy_(policy), scene_extent_(scene_extent) {}
     /// Extent taken from `scene`'s bounds.
     RayOffset(OffsetPolicy policy, const Scene& scene);
@@ -64,8 +65,10 @@ private:
 };
 
 /// Waechter & Binder's offset on its own: every coordinate of `p` moved
-/// 256 ULPs toward the side of `n`, or 1/65536 x n where |p| < 1/32 (ULPs
-/// are too small near zero).
-Vec3f offset_ray_origin_robust(const Vec3f& p, const Vec3f& n);
+/// 256 ULPs toward the side of `n`, or 1/65536 x extent x n where
+/// |p| < extent / 32 (ULPs are too small near zero). The chapter's constants
+/// are absolute (extent 1); scaling them by the scene's extent makes the
+/// offset scale-invariant.
+Vec3f offset_ray_origin_robust(const Vec3f& p, const Vec3f& n, float scene_extent = 1.0f);
 
 }  // namespace raypack

@@ -1,6 +1,7 @@
 // Secondary-ray origins (render/ray_offset.h): Waechter & Binder's robust
 // offset leaves no self-intersection from scale 1e-4 to 1e6 and at a 1e6
-// translation; a fixed epsilon fails at some scale, so the measure can fail.
+// translation, and renders the same picture from scale 1e-6 to 1e6; a fixed
+// epsilon fails at some scale, so the measures can fail.
 #include <gtest/gtest.h>
 
 #include <bit>
@@ -11,6 +12,9 @@
 #include "measure/closed_meshes.h"
 #include "render/ray_offset.h"
 #include "measure/ray_sets.h"
+#include "measure/scale_invariance.h"
+#include "scene/load.h"
+#include "tests/test_paths.h"
 
 namespace raypack {
 namespace {
@@ -60,6 +64,38 @@ TEST(RayOffset, RobustMovesEachCoordinate256UlpsTowardTheNormal) {
     const Vec3f near_zero = offset_ray_origin_robust({1e-9f, 0, -0.01f}, {0, 0, 1});
     EXPECT_EQ(near_zero.x, 1e-9f);
     EXPECT_FLOAT_EQ(near_zero.z, -0.01f + 1.0f / 65536);
+}
+
+TEST(RayOffset, RobustNearOriginConstantsScaleWithTheSceneExtent) {
+    // The chapter's 1/32 and 1/65536 hold for extent 1; at extent 1e-4 the
+    // threshold and the offset shrink with it (issue 19).
+    const Vec3f p{1e-7f, 0, 2e-6f};
+    const Vec3f small = offset_ray_origin_robust(p, {0, 0, 1}, 1e-4f);
+    EXPECT_EQ(small.x, p.x);
+    EXPECT_FLOAT_EQ(small.z, 2e-6f + 1e-4f / 65536);
+    // At 1e-4 / 32 and above: ULPs as everywhere else.
+    const Vec3f above = offset_ray_origin_robust({0, 0, 1e-5f}, {0, 0, 1}, 1e-4f);
+    EXPECT_EQ(std::bit_cast<std::int32_t>(above.z) - std::bit_cast<std::int32_t>(1e-5f), 256);
+}
+
+// The scene of balls.nff (spheres on a polygon) and of rings.nff (cones and
+// spheres) at 96 x 96, robust offset: scaled by 1e-6 ... 1e6 the picture stays
+// within 45 dB of the unscaled one (the issue's measure at 256 x 256 is in
+// docs/reliability.md; before the fix 1e-4 gave 21.9 dB on balls).
+TEST(RayOffset, RobustRenderIsTheSameAtEveryScale) {
+    for (const char* name : {"balls.nff", "rings.nff"}) {
+        const Scene scene = load_scene(std::string(RAYPACK_SOURCE_DIR) + "/scenes/" + name);
+        for (float s : {1e-6f, 1e-4f, 1e-2f, 1e3f, 1e6f}) {
+            const ImageError e = scale_invariance_error(scene, OffsetPolicy::Robust, s, Vec3f{}, 96, 96);
+            EXPECT_GE(e.psnr_db, 45.0) << name << " scale " << s;
+        }
+    }
+}
+
+TEST(RayOffset, FixedEpsilonRenderChangesWithScale) {
+    // The measure can fail: epsilon's absolute 1e-4 is a whole ball at 1e-4.
+    const Scene scene = load_scene(std::string(RAYPACK_SOURCE_DIR) + "/scenes/balls.nff");
+    EXPECT_LT(scale_invariance_error(scene, OffsetPolicy::Epsilon, 1e-4f, Vec3f{}, 96, 96).psnr_db, 30.0);
 }
 
 TEST(RayOffset, NamesRoundTrip) {
