@@ -271,6 +271,42 @@ TEST_P(EmbreeAgreement, PacketsMatchSingleRays) {
     }
 }
 
+/// A batch whose rays share one origin runs in Embree's coherent context; one
+/// ray from elsewhere appended to it makes the same batch incoherent. The
+/// camera rays must get the same answers both ways, at every width.
+TEST_P(EmbreeAgreement, CoherentContextMatchesIncoherent) {
+    const Scene scene = load_scene(std::string(RAYPACK_SOURCE_DIR) + "/scenes/" + GetParam());
+    const EmbreeAccel embree(scene);
+    const int size = 96;
+    const CameraFrame f = make_camera_frame(scene.camera, size, size);
+    std::vector<Rayf> coherent;
+    for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x) coherent.push_back(camera_ray(f, float(x) + 0.5f, float(y) + 0.5f));
+    std::vector<Rayf> mixed = coherent;
+    Rayf stray = coherent[0];
+    stray.org = stray.org + Vec3f{1.0f, 1.0f, 1.0f};
+    mixed.push_back(stray);
+    for (int width : {1, 4, 8, 16}) {
+        SCOPED_TRACE("width " + std::to_string(width) + " on " + GetParam());
+        std::vector<Hitf> a(coherent.size()), b(mixed.size());
+        embree.intersect_packets(width, coherent, a);
+        embree.intersect_packets(width, mixed, b);
+        std::vector<std::uint8_t> oa(coherent.size()), ob(mixed.size());
+        embree.occluded_packets(width, coherent, oa);
+        embree.occluded_packets(width, mixed, ob);
+        std::size_t unlike = 0, hits = 0, occ_unlike = 0;
+        for (std::size_t i = 0; i < coherent.size(); ++i) {
+            hits += a[i].found();
+            unlike += a[i].found() != b[i].found() || a[i].prim != b[i].prim ||
+                      std::fabs(a[i].t - b[i].t) > 1e-6f * std::max(a[i].t, b[i].t);
+            occ_unlike += oa[i] != ob[i];
+        }
+        EXPECT_GT(hits, 0u) << "the camera sees nothing: the test would prove nothing";
+        EXPECT_EQ(unlike, 0u) << "closest hits differ between the coherent and incoherent context";
+        EXPECT_EQ(occ_unlike, 0u) << "occlusion differs between the coherent and incoherent context";
+    }
+}
+
 // ---- Semantics the scene comparison depends on ----------------------------------
 
 Scene single(PrimKind kind) {

@@ -36,6 +36,22 @@ private:
     unsigned ftz_, daz_;
 };
 
+/// The intersect context for one batch. Embree's coherent mode (its frustum
+/// packet traversal, BVHNIntersectorKHybrid::intersectCoherent) is a promise
+/// about the rays; raypack keeps it exactly when every ray of the batch
+/// starts at one origin (camera rays), the same property raypack's default
+/// configuration keys on (app/default_config). The check is one pass of
+/// compares, exact, and needs no hint from the caller.
+RTCIntersectContext context_for(std::span<const Rayf> rays) {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    const bool one_origin = std::all_of(rays.begin(), rays.end(), [&](const Rayf& r) {
+        return r.org.x == rays[0].org.x && r.org.y == rays[0].org.y && r.org.z == rays[0].org.z;
+    });
+    if (one_origin && !rays.empty()) context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    return context;
+}
+
 RTCRay to_embree(const Rayf& r) {
     RTCRay ray;
     ray.org_x = r.org.x;
@@ -399,8 +415,7 @@ EmbreeAccel::~EmbreeAccel() {
 
 void EmbreeAccel::intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const {
     const DenormalsOff ftz;
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
+    RTCIntersectContext context = context_for(rays);
     for (std::size_t i = 0; i < rays.size(); ++i) {
         RTCRayHit rh;
         rh.ray = to_embree(rays[i]);
@@ -421,8 +436,7 @@ void EmbreeAccel::intersect(std::span<const Rayf> rays, std::span<Hitf> hits) co
 
 void EmbreeAccel::occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const {
     const DenormalsOff ftz;
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
+    RTCIntersectContext context = context_for(rays);
     for (std::size_t i = 0; i < rays.size(); ++i) {
         RTCRay ray = to_embree(rays[i]);
         rtcOccluded1(scene_, &context, &ray);
@@ -444,8 +458,7 @@ bool EmbreeAccel::native_packet(int width) const {
 template <int K>
 void EmbreeAccel::intersect_k(std::span<const Rayf> rays, std::span<Hitf> hits) const {
     const DenormalsOff ftz;
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);  // default flags: incoherent (see intersect_packets)
+    RTCIntersectContext context = context_for(rays);
     for (std::size_t first = 0; first < rays.size(); first += K) {
         const std::size_t n = std::min<std::size_t>(K, rays.size() - first);
         typename EmbreePacket<K>::RayHit rh;
@@ -473,8 +486,7 @@ void EmbreeAccel::intersect_k(std::span<const Rayf> rays, std::span<Hitf> hits) 
 template <int K>
 void EmbreeAccel::occluded_k(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const {
     const DenormalsOff ftz;
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
+    RTCIntersectContext context = context_for(rays);
     for (std::size_t first = 0; first < rays.size(); first += K) {
         const std::size_t n = std::min<std::size_t>(K, rays.size() - first);
         typename EmbreePacket<K>::Ray ray;
@@ -486,11 +498,8 @@ void EmbreeAccel::occluded_k(std::span<const Rayf> rays, std::span<std::uint8_t>
     }
 }
 
-// The context keeps rtcInitIntersectContext's default flags (INCOHERENT),
-// the mode Embree documents for general use. RTC_INTERSECT_CONTEXT_FLAG_COHERENT
-// would switch Embree 3.13's packet traversal of triangle-only BVHs to a
-// frustum path (BVHNIntersectorKHybrid::intersectCoherent), a promise about
-// the rays that raypack's shadow and diffuse ray sets do not keep.
+// Batches whose rays share one origin run in Embree's coherent context,
+// others in its default incoherent one (context_for above).
 void EmbreeAccel::intersect_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
     switch (width) {
         case 4: return intersect_k<4>(rays, hits);
