@@ -35,12 +35,28 @@ int run_info(const Args& args) {
     print_vec("up", c.up);
     std::printf("  %-10s %g\n  %-10s %g\n  %-10s %d %d\n", "angle", c.fov_deg, "hither", c.hither, "resolution", c.width,
                 c.height);
+    if (c.lens_radius > 0) std::printf("  %-10s radius %g, focused at %g\n", "lens", c.lens_radius, c.focus_distance);
     std::printf("background: %g %g %g\n", scene.background.x, scene.background.y, scene.background.z);
-    std::printf("lights: %zu\n", scene.lights.size());
-    for (const auto& l : scene.lights) {
-        std::printf("  at %g %g %g", l.position.x, l.position.y, l.position.z);
-        if (l.has_color) std::printf("  colour %g %g %g", l.color.x, l.color.y, l.color.z);
+    std::printf("lights: %zu\n", scene.light_count());
+    auto colour = [](bool has, const Vec3f& v) {
+        if (has) std::printf("  colour %g %g %g", v.x, v.y, v.z);
         std::printf("\n");
+    };
+    for (const auto& l : scene.lights) {
+        std::printf("  point at %g %g %g", l.position.x, l.position.y, l.position.z);
+        colour(l.has_color, l.color);
+    }
+    for (const auto& l : scene.area_lights) {
+        if (l.shape == AreaLightShape::Sphere)
+            std::printf("  sphere at %g %g %g radius %g", l.center.x, l.center.y, l.center.z, l.radius);
+        else
+            std::printf("  parallelogram at %g %g %g edges %g %g %g, %g %g %g", l.corner.x, l.corner.y, l.corner.z,
+                        l.edge1.x, l.edge1.y, l.edge1.z, l.edge2.x, l.edge2.y, l.edge2.z);
+        colour(l.has_color, l.color);
+    }
+    for (const auto& l : scene.distant_lights) {
+        std::printf("  distant along %g %g %g", l.direction.x, l.direction.y, l.direction.z);
+        colour(l.has_color, l.color);
     }
     const Features& f = scene.features;
     std::printf("features:");
@@ -51,7 +67,11 @@ int run_info(const Args& args) {
                                                   {f.reflection, "reflection"},
                                                   {f.transmission, "transmission"},
                                                   {f.colored_lights, "coloured-lights"},
-                                                  {f.inside_only, "inside-only"}};
+                                                  {f.inside_only, "inside-only"},
+                                                  {f.area_lights, "area-lights"},
+                                                  {f.distant_lights, "distant-lights"},
+                                                  {f.glossy, "glossy"},
+                                                  {f.thin_lens, "thin-lens"}};
     for (const auto& [on, name] : names)
         if (on) std::printf(" %s", name);
     std::printf("\n");

@@ -25,7 +25,16 @@ Scene transformed_scene(const Scene& scene, float scale, const Vec3f& translatio
     place(out.camera.from);
     place(out.camera.at);
     out.camera.hither *= scale;
+    out.camera.lens_radius *= scale;
+    out.camera.focus_distance *= scale;
     for (PointLight& l : out.lights) place(l.position);
+    for (AreaLight& l : out.area_lights) {
+        place(l.corner);
+        place(l.center);
+        l.edge1 = l.edge1 * scale;
+        l.edge2 = l.edge2 * scale;
+        l.radius *= scale;
+    }
     for (Vec3f& c : out.spheres.center) place(c);
     for (float& r : out.spheres.radius) r *= scale;
     for (auto* v : {&out.triangles.p0, &out.triangles.p1, &out.triangles.p2})

@@ -2,6 +2,7 @@
 // whitespace-separated tokens, so that the one-line cone the SPD programs
 // write and the three-line cone the format document shows both load.
 #include <cmath>
+#include <filesystem>
 #include <iterator>
 #include <istream>
 #include <span>
@@ -77,7 +78,7 @@ private:
     int line_ = 1;
 };
 
-std::string quoted(std::string_view tok) {
+std::string quote_token(std::string_view tok) {
     constexpr std::size_t kMax = 40;  // keep messages readable on binary junk
     // Appended piecewise: "'" + std::string(...) trips gcc 12's -Wrestrict.
     std::string q(1, '\'');
@@ -103,11 +104,17 @@ public:
             else if (kw == "s") sphere();
             else if (kw == "p") polygon(false);
             else if (kw == "pp") polygon(true);
+            else if (kw == "la") parallelogram_light();
+            else if (kw == "ls") sphere_light();
+            else if (kw == "ld") distant_light();
+            else if (kw == "obj") obj_mesh();
+            else if (kw == "lens") lens();
+            else if (kw == "gloss") gloss();
             else if (float x; parse_float_token(kw, x) != NumberToken::NotNumber)
-                fail(entity_line_, "unexpected number " + quoted(kw) +
+                fail(entity_line_, "unexpected number " + quote_token(kw) +
                                        " where an entity keyword was expected (too many values before it?)");
             else
-                fail(entity_line_, "unknown keyword " + quoted(kw));
+                fail(entity_line_, "unknown keyword " + quote_token(kw));
         }
         scene_.has_camera = camera_line_ != 0;
         scene_.update_features();
@@ -118,7 +125,7 @@ private:
     [[noreturn]] void fail(int line, const std::string& problem) const { throw SceneError(name_, line, problem); }
 
     /// " (p on line 12)": which entity a value belongs to.
-    std::string where() const { return " (" + quoted(entity_) + " on line " + std::to_string(entity_line_) + ")"; }
+    std::string where() const { return " (" + quote_token(entity_) + " on line " + std::to_string(entity_line_) + ")"; }
 
     std::string_view expect_token(const std::string& what) {
         const std::string_view t = tok_.next();
@@ -137,10 +144,10 @@ private:
         if (index >= 0) desc += " of vertex " + std::to_string(index + 1) + " of " + std::to_string(of);
         if (t.empty()) fail(tok_.line(), "unexpected end of file: expected " + desc + where());
         if (r == NumberToken::NotNumber)
-            fail(tok_.line(), "expected a number for " + desc + where() + ", got " + quoted(t));
+            fail(tok_.line(), "expected a number for " + desc + where() + ", got " + quote_token(t));
         if (r == NumberToken::NonFinite)
-            fail(tok_.line(), "non-finite number " + quoted(t) + " for " + desc + where());
-        fail(tok_.line(), "number " + quoted(t) + " out of range for " + desc + where());
+            fail(tok_.line(), "non-finite number " + quote_token(t) + " for " + desc + where());
+        fail(tok_.line(), "number " + quote_token(t) + " out of range for " + desc + where());
     }
 
     long long integer(const std::string& what) {
@@ -148,8 +155,8 @@ private:
         long long v = 0;
         const NumberToken r = parse_int_token(t, v);
         if (r == NumberToken::Ok) return v;
-        if (r == NumberToken::OutOfRange) fail(tok_.line(), what + " " + quoted(t) + " out of range" + where());
-        fail(tok_.line(), "expected an integer for " + what + where() + ", got " + quoted(t));
+        if (r == NumberToken::OutOfRange) fail(tok_.line(), what + " " + quote_token(t) + " out of range" + where());
+        fail(tok_.line(), "expected an integer for " + what + where() + ", got " + quote_token(t));
     }
 
     Vec3f vec3(const char* what, long long index = -1, long long of = 0) {
@@ -162,8 +169,8 @@ private:
     }
 
     void keyword(std::string_view expected) {
-        const std::string_view t = expect_token(quoted(expected));
-        if (t != expected) fail(tok_.line(), "expected " + quoted(expected) + where() + ", got " + quoted(t));
+        const std::string_view t = expect_token(quote_token(expected));
+        if (t != expected) fail(tok_.line(), "expected " + quote_token(expected) + where() + ", got " + quote_token(t));
     }
 
     /// Objects before any "f" get a default material rather than an error.
@@ -212,13 +219,95 @@ private:
     void light() {
         PointLight l;
         l.position = vec3("light position");
-        // The colour is optional: present when a number follows.
-        float x;
-        if (parse_float_token(tok_.peek(), x) != NumberToken::NotNumber) {
-            l.color = vec3("light colour");
-            l.has_color = true;
-        }
+        l.has_color = optional_color(l.color, false);
         scene_.lights.push_back(l);
+    }
+
+    /// A light's optional "r g b": present when a number follows. The
+    /// extensions' lights (`emitting`) refuse negative components.
+    bool optional_color(Vec3f& color, bool emitting) {
+        float x;
+        if (parse_float_token(tok_.peek(), x) == NumberToken::NotNumber) return false;
+        color = vec3("light colour");
+        if (emitting && (color.x < 0 || color.y < 0 || color.z < 0))
+            fail(tok_.line(), "negative light colour" + where());
+        return true;
+    }
+
+    /// The material of a light's own surface: the current one, marked as
+    /// covering area light `light`.
+    std::uint32_t emitter_material(std::size_t light) {
+        Material m = scene_.materials[material()];
+        m.area_light = std::int32_t(light);
+        scene_.materials.push_back(m);
+        return std::uint32_t(scene_.materials.size() - 1);
+    }
+
+    void parallelogram_light() {
+        AreaLight l;
+        l.shape = AreaLightShape::Parallelogram;
+        l.corner = vec3("light corner");
+        l.edge1 = vec3("light edge e");
+        l.edge2 = vec3("light edge f");
+        if (!(length(cross(l.edge1, l.edge2)) > 0))
+            fail(tok_.line(), "light edges e and f are zero or parallel" + where());
+        l.has_color = optional_color(l.color, true);
+        const std::uint32_t m = emitter_material(scene_.area_lights.size());
+        const Vec3f a = l.corner, b = l.corner + l.edge1, c = b + l.edge2, d = l.corner + l.edge2;
+        // Both triangles face cross(e, f), the emitting side.
+        l.first_prim = scene_.add_triangle(a, b, c, m);
+        scene_.add_triangle(a, c, d, m);
+        l.prim_count = 2;
+        scene_.area_lights.push_back(l);
+    }
+
+    void sphere_light() {
+        AreaLight l;
+        l.shape = AreaLightShape::Sphere;
+        l.center = vec3("light centre");
+        l.radius = number("light radius");
+        if (!(l.radius > 0)) fail(tok_.line(), "light radius must be positive" + where());
+        l.has_color = optional_color(l.color, true);
+        l.first_prim = scene_.add_sphere(l.center, l.radius, emitter_material(scene_.area_lights.size()));
+        l.prim_count = 1;
+        scene_.area_lights.push_back(l);
+    }
+
+    void distant_light() {
+        DistantLight l;
+        const Vec3f d = vec3("light direction");
+        if (!(length(d) > 0)) fail(tok_.line(), "zero light direction" + where());
+        l.direction = normalize(d);
+        l.has_color = optional_color(l.color, true);
+        scene_.distant_lights.push_back(l);
+    }
+
+    // `obj FILE`: a relative FILE is relative to the NFF file's folder.
+    void obj_mesh() {
+        const std::string file(expect_token("OBJ file name"));
+        std::filesystem::path path(file);
+        if (path.is_relative() && !name_.starts_with("gen:")) path = std::filesystem::path(name_).parent_path() / path;
+        try {
+            append_obj_triangles(path.string(), material(), scene_);
+        } catch (const SceneError& e) {
+            fail(entity_line_, "obj " + quote_token(file) + ": " + e.what());
+        }
+    }
+
+    void lens() {
+        if (lens_line_ != 0)
+            fail(entity_line_, "second 'lens' line (the first is on line " + std::to_string(lens_line_) + ")");
+        Camera& cam = scene_.camera;
+        cam.lens_radius = number("lens radius");
+        if (cam.lens_radius < 0) fail(tok_.line(), "negative lens radius" + where());
+        cam.focus_distance = number("focus distance");
+        if (!(cam.focus_distance > 0)) fail(tok_.line(), "focus distance must be positive" + where());
+        lens_line_ = entity_line_;
+    }
+
+    void gloss() {
+        gloss_ = number("gloss exponent");
+        if (gloss_ < 0) fail(tok_.line(), "negative gloss exponent" + where());
     }
 
     void fill() {
@@ -229,6 +318,7 @@ private:
         m.shine = number("Shine");
         m.transmittance = number("T");
         m.ior = number("index of refraction");
+        m.gloss = gloss_;
         scene_.materials.push_back(m);
     }
 
@@ -286,6 +376,8 @@ private:
     std::string_view entity_;  ///< keyword of the entity being read
     int entity_line_ = 0;
     int camera_line_ = 0;  ///< line of the "v" block, 0 while none
+    int lens_line_ = 0;    ///< line of the "lens" line, 0 while none
+    float gloss_ = 0;      ///< the last "gloss" value, for the "f" lines after it
     std::vector<Vec3f> verts_, normals_;  ///< reused between polygons
 };
 

@@ -1,6 +1,7 @@
 #pragma once
 // Private to the loaders: NFF parsing straight from text already in memory, so
 // that generated scenes are not copied into a stream first.
+#include <cstdint>
 #include <string>
 #include <string_view>
 
@@ -10,5 +11,9 @@ namespace raypack {
 
 /// Throws SceneError naming `name`.
 Scene load_nff_text(std::string_view text, const std::string& name);
+
+/// The faces of OBJ file `path` as triangles of `material`, appended to
+/// `scene` (NFF's `obj` line and load_obj_file). Throws SceneError naming `path`.
+void append_obj_triangles(const std::string& path, std::uint32_t material, Scene& scene);
 
 }  // namespace raypack

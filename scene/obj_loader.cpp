@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "scene/load.h"
+#include "scene/nff_text.h"
 #include "scene/number_token.h"
 #include "scene/read_file.h"
 #include "scene/triangulate.h"
@@ -150,7 +151,7 @@ void frame(Scene& scene) {
 
 }  // namespace
 
-Scene load_obj_file(const std::string& path) {
+void append_obj_triangles(const std::string& path, std::uint32_t material, Scene& scene) {
     const std::string text = read_scene_file(path);
     const std::vector<int> face_lines = prescan(text, path);
 
@@ -168,13 +169,6 @@ Scene load_obj_file(const std::string& path) {
         throw SceneError(path, line_in_message(msg), "tinyobjloader: " + msg);
     }
 
-    Scene scene;
-    scene.source = path;
-    Material grey;
-    grey.color = {0.8f, 0.8f, 0.8f};
-    grey.kd = 0.8f;
-    scene.materials.push_back(grey);
-
     const std::size_t nv = attrib.vertices.size() / 3, nn = attrib.normals.size() / 3;
     auto position = [&](int i) {
         return Vec3f(float(attrib.vertices[3 * i]), float(attrib.vertices[3 * i + 1]), float(attrib.vertices[3 * i + 2]));
@@ -182,6 +176,7 @@ Scene load_obj_file(const std::string& path) {
     auto normal = [&](int i) {
         return Vec3f(float(attrib.normals[3 * i]), float(attrib.normals[3 * i + 1]), float(attrib.normals[3 * i + 2]));
     };
+    const std::size_t triangles_before = scene.triangles.size();
     std::vector<Vec3f> pos, nrm;
     std::size_t face = 0;
     for (const tinyobj::shape_t& shape : shapes) {
@@ -210,16 +205,26 @@ Scene load_obj_file(const std::string& path) {
             }
             for (const auto& tri : triangulate_polygon(std::span<const Vec3f>(pos))) {
                 if (normals)
-                    scene.add_triangle(pos[tri[0]], pos[tri[1]], pos[tri[2]], nrm[tri[0]], nrm[tri[1]], nrm[tri[2]], 0);
+                    scene.add_triangle(pos[tri[0]], pos[tri[1]], pos[tri[2]], nrm[tri[0]], nrm[tri[1]], nrm[tri[2]],
+                                       material);
                 else
-                    scene.add_triangle(pos[tri[0]], pos[tri[1]], pos[tri[2]], 0);
+                    scene.add_triangle(pos[tri[0]], pos[tri[1]], pos[tri[2]], material);
             }
         }
     }
     if (const std::string w = relevant_warning(warn); !w.empty())
         throw SceneError(path, line_in_message(w), "tinyobjloader: " + w);
-    if (scene.triangles.size() == 0) throw SceneError(path, 0, "no faces");
+    if (scene.triangles.size() == triangles_before) throw SceneError(path, 0, "no faces");
+}
 
+Scene load_obj_file(const std::string& path) {
+    Scene scene;
+    scene.source = path;
+    Material grey;
+    grey.color = {0.8f, 0.8f, 0.8f};
+    grey.kd = 0.8f;
+    scene.materials.push_back(grey);
+    append_obj_triangles(path, 0, scene);
     frame(scene);
     scene.update_features();
     return scene;

@@ -1,6 +1,8 @@
 #include "scene/scene.h"
 
+#include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace raypack {
 
@@ -61,8 +63,24 @@ void Scene::update_features() {
         f.reflection |= materials[m].ks > 0;
         f.transmission |= materials[m].transmittance > 0;
     }
+    for (std::uint32_t m : prim_material) f.glossy |= materials[m].gloss > 0;
     for (const auto& l : lights) f.colored_lights |= l.has_color;
+    for (const auto& l : area_lights) f.colored_lights |= l.has_color;
+    for (const auto& l : distant_lights) f.colored_lights |= l.has_color;
+    f.area_lights = !area_lights.empty();
+    f.distant_lights = !distant_lights.empty();
+    f.thin_lens = camera.lens_radius > 0;
     features = f;
+}
+
+float AreaLight::area() const {
+    if (shape == AreaLightShape::Sphere) return 4.0f * std::numbers::pi_v<float> * radius * radius;
+    return length(cross(edge1, edge2));
+}
+
+float Scene::spd_light_intensity() const {
+    const float n = float(std::max<std::size_t>(light_count(), 1));
+    return std::sqrt(n) / (2.0f * n);
 }
 
 Box3f primitive_bounds(const Scene& s, std::uint32_t prim) {

@@ -25,12 +25,44 @@ struct Material {
     float shine = 0;
     float transmittance = 0;
     float ior = 1;
+    /// NFF extension `gloss n`: reflection samples a Phong lobe cos^n around
+    /// the mirror direction; 0 is the perfect mirror of plain NFF.
+    float gloss = 0;
+    /// The area light (index into Scene::area_lights) whose surface this
+    /// material covers, or -1: camera and secondary rays that hit it see it.
+    std::int32_t area_light = -1;
 };
 
 struct PointLight {
     Vec3f position;
     Vec3f color{1, 1, 1};
     bool has_color = false;  ///< NFF lights may omit their colour.
+};
+
+enum class AreaLightShape : std::uint8_t { Parallelogram, Sphere };
+
+/// NFF extensions `la` (a parallelogram corner + s edge1 + t edge2, s, t in
+/// [0, 1], emitting from the side cross(edge1, edge2) points to) and `ls` (a
+/// sphere emitting outwards). Its surface is also geometry of the scene
+/// (primitives [first_prim, first_prim + prim_count)), so rays see it.
+struct AreaLight {
+    AreaLightShape shape = AreaLightShape::Parallelogram;
+    Vec3f corner, edge1, edge2;  ///< Parallelogram
+    Vec3f center;                ///< Sphere
+    float radius = 0;            ///< Sphere
+    Vec3f color{1, 1, 1};
+    bool has_color = false;
+    std::uint32_t first_prim = 0, prim_count = 0;
+
+    float area() const;
+};
+
+/// NFF extension `ld`: light arriving from infinitely far along `direction`
+/// (unit length, the way the light travels).
+struct DistantLight {
+    Vec3f direction{0, 0, -1};
+    Vec3f color{1, 1, 1};
+    bool has_color = false;
 };
 
 /// NFF viewpoint. fov_deg spans the centres of the top and bottom pixel rows.
@@ -42,6 +74,11 @@ struct Camera {
     float hither = 0;
     int width = 512;
     int height = 512;
+    /// NFF extension `lens radius focus`: a thin lens of this aperture
+    /// radius focused at this distance along the view direction; radius 0
+    /// is the pinhole of plain NFF.
+    float lens_radius = 0;
+    float focus_distance = 0;
 };
 
 struct SphereSoA {
@@ -79,6 +116,10 @@ struct Features {
     bool transmission = false;  ///< some material has T > 0
     bool colored_lights = false;
     bool inside_only = false;   ///< negative radii
+    bool area_lights = false;
+    bool distant_lights = false;
+    bool glossy = false;        ///< some material has gloss > 0
+    bool thin_lens = false;
 };
 
 struct Scene {
@@ -86,7 +127,9 @@ struct Scene {
     Camera camera;
     bool has_camera = false;
     Vec3f background{0, 0, 0};
-    std::vector<PointLight> lights;
+    std::vector<PointLight> lights;  ///< point lights (`l`)
+    std::vector<AreaLight> area_lights;
+    std::vector<DistantLight> distant_lights;
     std::vector<Material> materials;
 
     SphereSoA spheres;
@@ -99,6 +142,10 @@ struct Scene {
     Features features;
 
     std::size_t primitive_count() const { return prims.size(); }
+    /// Lights of every kind: the L of the SPD intensity rule.
+    std::size_t light_count() const { return lights.size() + area_lights.size() + distant_lights.size(); }
+    /// SPD Readme: each light (and the ambient term) gets sqrt(L) / (2 L).
+    float spd_light_intensity() const;
 
     // Appending keeps the global numbering in definition order.
     std::uint32_t add_sphere(const Vec3f& c, float r, std::uint32_t material);

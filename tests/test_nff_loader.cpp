@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "scene/load.h"
+#include "tests/scene_files.h"
 
 namespace {
 
@@ -22,45 +23,9 @@ std::string scene_path(const std::string& file) { return std::string(RAYPACK_SOU
 
 }  // namespace
 
-/// Each test writes its files into its own temporary folder (per process and
-/// test, since test runs may overlap) and removes it afterwards.
-class NffLoader : public ::testing::Test {
+class NffLoader : public SceneFiles {
 protected:
-    void SetUp() override {
-        dir_ = std::filesystem::temp_directory_path() /
-               ("raypack_nff_" + std::to_string(::getpid()) + "_" +
-                ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        std::filesystem::create_directories(dir_);
-    }
-    void TearDown() override {
-        std::error_code ec;
-        std::filesystem::remove_all(dir_, ec);
-    }
-
-    std::string write(const std::string& name, const std::string& text) {
-        const std::string path = (dir_ / name).string();
-        std::ofstream(path, std::ios::binary) << text;
-        return path;
-    }
-
-    Scene load(const std::string& text) { return raypack::load_nff_file(write("scene.nff", text)); }
-
-    /// Loading `text` fails with a SceneError naming the file, `line` and `phrase`.
-    void expect_error(const std::string& text, int line, const std::string& phrase) {
-        const std::string path = write("bad.nff", text);
-        try {
-            raypack::load_nff_file(path);
-            ADD_FAILURE() << "no error for:\n" << text;
-        } catch (const SceneError& e) {
-            EXPECT_EQ(e.file(), path);
-            EXPECT_EQ(e.line(), line) << e.what();
-            EXPECT_NE(e.problem().find(phrase), std::string::npos) << e.what();
-            const std::string prefix = path + ":" + std::to_string(line) + ": ";
-            EXPECT_EQ(std::string(e.what()).rfind(prefix, 0), 0u) << e.what();
-        }
-    }
-
-    std::filesystem::path dir_;
+    NffLoader() : SceneFiles(raypack::load_nff_file, ".nff") {}
 };
 
 namespace {

@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "scene/load.h"
+#include "tests/scene_files.h"
 
 namespace {
 
@@ -21,42 +22,9 @@ using raypack::Vec3f;
 
 }  // namespace
 
-/// Each test writes into its own temporary folder (per process and test).
-class ObjLoader : public ::testing::Test {
+class ObjLoader : public SceneFiles {
 protected:
-    void SetUp() override {
-        dir_ = std::filesystem::temp_directory_path() /
-               ("raypack_obj_" + std::to_string(::getpid()) + "_" +
-                ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        std::filesystem::create_directories(dir_);
-    }
-    void TearDown() override {
-        std::error_code ec;
-        std::filesystem::remove_all(dir_, ec);
-    }
-
-    std::string write(const std::string& name, const std::string& text) {
-        const std::string path = (dir_ / name).string();
-        std::ofstream(path, std::ios::binary) << text;
-        return path;
-    }
-
-    Scene load(const std::string& text) { return raypack::load_obj_file(write("mesh.obj", text)); }
-
-    void expect_error(const std::string& text, int line, const std::string& phrase) {
-        const std::string path = write("bad.obj", text);
-        try {
-            raypack::load_obj_file(path);
-            ADD_FAILURE() << "no error for:\n" << text;
-        } catch (const SceneError& e) {
-            EXPECT_EQ(e.file(), path);
-            EXPECT_EQ(e.line(), line) << e.what();
-            EXPECT_NE(e.problem().find(phrase), std::string::npos) << e.what();
-            EXPECT_EQ(std::string(e.what()).rfind(path + ":" + std::to_string(line) + ": ", 0), 0u) << e.what();
-        }
-    }
-
-    std::filesystem::path dir_;
+    ObjLoader() : SceneFiles(raypack::load_obj_file, ".obj") {}
 };
 
 TEST_F(ObjLoader, BunnyLoadsWithAFramingCamera) {

@@ -192,7 +192,8 @@ TEST(SpdGenerators, ListsGeneratorsWithDefaults) {
     EXPECT_EQ(defaults["tree"], 11);
     EXPECT_EQ(defaults["gears"], 4);
     EXPECT_EQ(defaults["teapot"], 6);
-    EXPECT_EQ(gens.size(), 7u);
+    EXPECT_EQ(defaults["cornell"], 1);
+    EXPECT_EQ(gens.size(), 8u);
 }
 
 TEST(SpdGenerators, RejectsUnknownNamesAndBadSizes) {

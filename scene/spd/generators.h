@@ -13,5 +13,7 @@ std::string generate_rings(int size);
 std::string generate_tree(int size);
 std::string generate_gears(int size);
 std::string generate_teapot(int size);
+/// Not an SPD scene: the Cornell box (size 1 with its blocks, 2 with spheres).
+std::string generate_cornell(int size);
 
 }  // namespace raypack::spd

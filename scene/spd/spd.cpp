@@ -29,6 +29,7 @@ constexpr Entry kGenerators[] = {
     {"tree", 11, 18, spd::generate_tree},
     {"gears", 4, 12, spd::generate_gears},
     {"teapot", 6, 64, spd::generate_teapot},
+    {"cornell", 1, 2, spd::generate_cornell},
 };
 
 std::string valid_names() {
