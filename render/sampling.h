@@ -54,6 +54,42 @@ Vec3<T> cosine_hemisphere(T u1, T u2) {
     return {d.x, d.y, std::sqrt(std::max(T(0), T(1) - d.x * d.x - d.y * d.y))};
 }
 
+/// Shirley and Chiu's concentric map of the unit square onto the unit disk
+/// ("A Low Distortion Map Between Disk and Square", JGT 1997): strata of
+/// the square stay compact on the disk, unlike the polar map's slivers.
+template <class T>
+Vec3<T> concentric_disk(T u1, T u2) {
+    const T a = T(2) * u1 - T(1), b = T(2) * u2 - T(1);
+    if (a == 0 && b == 0) return {T(0), T(0), T(0)};
+    const T quarter_pi = std::numbers::pi_v<T> / T(4);
+    T r, phi;
+    if (std::abs(a) > std::abs(b)) {
+        r = a;
+        phi = quarter_pi * (b / a);
+    } else {
+        r = b;
+        phi = T(2) * quarter_pi - quarter_pi * (a / b);
+    }
+    return {r * std::cos(phi), r * std::sin(phi), T(0)};
+}
+
+/// A direction about +z with density (n + 1) / (2 pi) cos^n(theta): the
+/// Phong lobe of exponent n (Lafortune and Willems 1994: cos theta =
+/// u1^(1 / (n + 1))). n = 0 is the uniform hemisphere.
+template <class T>
+Vec3<T> phong_lobe(T n, T u1, T u2) {
+    const T cos_t = std::pow(u1, T(1) / (n + T(1)));
+    const T sin_t = std::sqrt(std::max(T(0), T(1) - cos_t * cos_t));
+    const T phi = T(2) * std::numbers::pi_v<T> * u2;
+    return {sin_t * std::cos(phi), sin_t * std::sin(phi), cos_t};
+}
+
+/// Density of phong_lobe(n, ...) at a direction whose cosine to +z is cos_t.
+template <class T>
+T phong_lobe_pdf(T n, T cos_t) {
+    return cos_t <= 0 ? T(0) : (n + T(1)) / (T(2) * std::numbers::pi_v<T>) * std::pow(cos_t, n);
+}
+
 /// An orthonormal frame (t, b, n) about unit n (Duff et al., "Building an
 /// Orthonormal Basis, Revisited", JCGT 2017).
 template <class T>

@@ -1,0 +1,168 @@
+#include "render/sampler.h"
+
+#include <bit>
+#include <cmath>
+#include <stdexcept>
+
+namespace raypack {
+namespace {
+
+/// A 64-bit finaliser (SplitMix64's, Steele, Lea, Flood 2014) over a few
+/// keys: the seed of one (pixel, dimension, purpose).
+std::uint64_t mix(std::uint64_t h) {
+    h = (h ^ (h >> 30)) * 0xBF58476D1CE4E5B9ull;
+    h = (h ^ (h >> 27)) * 0x94D049BB133111EBull;
+    return h ^ (h >> 31);
+}
+
+std::uint64_t hash_keys(std::uint64_t seed, std::uint64_t pixel, std::uint64_t dimension, std::uint64_t purpose) {
+    std::uint64_t h = mix(seed + 0x9E3779B97F4A7C15ull);
+    h = mix(h ^ (pixel + 0x9E3779B97F4A7C15ull * 2));
+    h = mix(h ^ (dimension * 0x100000001B3ull + purpose + 1));
+    return h;
+}
+
+/// [0, 1) from the top 24 bits, so that the float never rounds up to 1.
+float unit_float(std::uint32_t bits) { return float(bits >> 8) * 0x1.0p-24f; }
+
+/// A pseudo-random permutation of [0, n) (Kensler, "Correlated
+/// Multi-Jittered Sampling", Pixar Technical Memo 13-01, 2013): an
+/// invertible hash on the smallest power-of-two range that holds n, walked
+/// until it lands below n (cycle walking).
+std::uint32_t permute(std::uint32_t i, std::uint32_t n, std::uint32_t key) {
+    std::uint32_t w = n - 1;
+    w |= w >> 1;
+    w |= w >> 2;
+    w |= w >> 4;
+    w |= w >> 8;
+    w |= w >> 16;
+    do {
+        i ^= key;
+        i *= 0xe170893du;
+        i ^= key >> 16;
+        i ^= (i & w) >> 4;
+        i ^= key >> 8;
+        i *= 0x0929eb3fu;
+        i ^= key >> 23;
+        i ^= (i & w) >> 1;
+        i *= 1u | key >> 27;
+        i *= 0x6935fa69u;
+        i ^= (i & w) >> 11;
+        i *= 0x74dcb303u;
+        i ^= (i & w) >> 2;
+        i *= 0x9e501cc3u;
+        i ^= (i & w) >> 2;
+        i *= 0xc860a3dfu;
+        i &= w;
+        i ^= i >> 5;
+    } while (i >= n);
+    return (i + key) % n;
+}
+
+std::uint32_t reverse_bits(std::uint32_t x) {
+    x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
+    x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
+    x = ((x >> 4) & 0x0F0F0F0Fu) | ((x & 0x0F0F0F0Fu) << 4);
+    x = ((x >> 8) & 0x00FF00FFu) | ((x & 0x00FF00FFu) << 8);
+    return (x >> 16) | (x << 16);
+}
+
+/// Owen scrambling of a 32-bit fraction in one hash (Burley, "Practical
+/// Hash-based Owen Scrambling", JCGT 2020, after Laine and Karras 2011): in
+/// bit-reversed order, each bit is flipped by a function of the bits above
+/// it in the fraction, which is what a nested uniform scramble does.
+std::uint32_t owen_scramble(std::uint32_t x, std::uint32_t seed) {
+    x = reverse_bits(x);
+    x += seed;
+    x ^= x * 0x6c50b47cu;
+    x ^= x * 0xb82f1e52u;
+    x ^= x * 0xc7afe638u;
+    x ^= x * 0x8d22f6e6u;
+    return reverse_bits(x);
+}
+
+/// The first two dimensions of Sobol's sequence as 32-bit fractions: the
+/// van der Corput sequence, and the dimension of primitive polynomial x + 1
+/// (direction numbers v_k = v_(k-1) ^ (v_(k-1) >> 1)). Any 2^m consecutive
+/// aligned points form a (0, m, 2)-net in base 2.
+std::uint32_t sobol0(std::uint32_t i) { return reverse_bits(i); }
+
+std::uint32_t sobol1(std::uint32_t i) {
+    std::uint32_t x = 0, v = 1u << 31;
+    for (; i; i >>= 1, v ^= v >> 1)
+        if (i & 1) x ^= v;
+    return x;
+}
+
+}  // namespace
+
+std::optional<SamplerKind> sampler_from_name(std::string_view name) {
+    if (name == "regular") return SamplerKind::Regular;
+    if (name == "random") return SamplerKind::Random;
+    if (name == "stratified") return SamplerKind::Stratified;
+    if (name == "sobol") return SamplerKind::Sobol;
+    return std::nullopt;
+}
+
+const char* sampler_name(SamplerKind kind) {
+    switch (kind) {
+        case SamplerKind::Regular: return "regular";
+        case SamplerKind::Random: return "random";
+        case SamplerKind::Stratified: return "stratified";
+        case SamplerKind::Sobol: return "sobol";
+    }
+    return "?";
+}
+
+StrataGrid strata_grid(int spp) {
+    if (spp < 1) throw std::invalid_argument("strata_grid: spp must be at least 1");
+    int nx = int(std::sqrt(double(spp)));
+    while (spp % nx != 0) --nx;
+    return {nx, spp / nx};
+}
+
+Sampler::Sampler(SamplerKind kind, int spp, std::uint64_t seed)
+    : kind_(kind), spp_(spp), seed_(seed), grid_(strata_grid(spp)) {}
+
+Sample2 Sampler::get(std::uint64_t pixel, int index, int dimension) const {
+    const auto n = std::uint32_t(spp_), i = std::uint32_t(index);
+    switch (kind_) {
+        case SamplerKind::Regular: {
+            // Dimension 0 walks the grid in order; the others in one fixed
+            // order per dimension (the same for every pixel), so that the lens
+            // sample is not a function of the position in the pixel.
+            const std::uint32_t cell = dimension == 0 ? i : permute(i, n, std::uint32_t(mix(seed_ + dimension)));
+            return {(float(cell % std::uint32_t(grid_.nx)) + 0.5f) / float(grid_.nx),
+                    (float(cell / std::uint32_t(grid_.nx)) + 0.5f) / float(grid_.ny)};
+        }
+        case SamplerKind::Random: {
+            const std::uint64_t h = hash_keys(seed_, pixel, std::uint64_t(dimension), 1 + std::uint64_t(i) * 4);
+            return {unit_float(std::uint32_t(h)), unit_float(std::uint32_t(h >> 32))};
+        }
+        case SamplerKind::Stratified: {
+            // Cells shuffled per pixel and dimension (pbrt's stratified
+            // sampler shuffles too), so that dimensions are not correlated.
+            const std::uint64_t key = hash_keys(seed_, pixel, std::uint64_t(dimension), 0);
+            const std::uint32_t cell = permute(i, n, std::uint32_t(key));
+            const std::uint64_t jitter = hash_keys(seed_, pixel, std::uint64_t(dimension), 2 + std::uint64_t(i) * 4);
+            const float jx = unit_float(std::uint32_t(jitter)), jy = unit_float(std::uint32_t(jitter >> 32));
+            // The sum can round up to the next cell's edge, never to 1.
+            const float x = (float(cell % std::uint32_t(grid_.nx)) + jx) / float(grid_.nx);
+            const float y = (float(cell / std::uint32_t(grid_.nx)) + jy) / float(grid_.ny);
+            return {x < 1.0f ? x : 0x1.fffffep-1f, y < 1.0f ? y : 0x1.fffffep-1f};
+        }
+        case SamplerKind::Sobol: {
+            // Burley (2020): shuffle the index by an Owen scramble (which keeps
+            // it inside one aligned block of 2^m points, a (0, m, 2)-net), then
+            // Owen-scramble each coordinate; seeds per pixel and dimension.
+            const std::uint64_t k1 = hash_keys(seed_, pixel, std::uint64_t(dimension), 0);
+            const std::uint64_t k2 = hash_keys(seed_, pixel, std::uint64_t(dimension), 3);
+            const std::uint32_t shuffled = owen_scramble(i, std::uint32_t(k1));
+            return {unit_float(owen_scramble(sobol0(shuffled), std::uint32_t(k1 >> 32))),
+                    unit_float(owen_scramble(sobol1(shuffled), std::uint32_t(k2)))};
+        }
+    }
+    return {};
+}
+
+}  // namespace raypack

@@ -1,0 +1,54 @@
+#pragma once
+// Sample points of the unit square for pixel samples (image position, lens,
+// light, lobe, time): each is a pure function of (seed, pixel, sample index,
+// dimension), so an image does not depend on thread count or tile order.
+#include <cstdint>
+#include <optional>
+#include <string_view>
+
+namespace raypack {
+
+enum class SamplerKind : std::uint8_t {
+    Regular,     ///< cell centres of a grid of spp cells (aliases; no noise)
+    Random,      ///< independent uniform points
+    Stratified,  ///< one jittered point per grid cell, cells shuffled per dimension
+    Sobol,       ///< Owen-scrambled Sobol' points, shuffled per pixel and dimension
+};
+
+std::optional<SamplerKind> sampler_from_name(std::string_view name);
+const char* sampler_name(SamplerKind kind);
+
+/// A 2D point in [0, 1)^2.
+struct Sample2 {
+    float x = 0, y = 0;
+};
+
+/// The grid of the regular and stratified samplers for `spp` samples: nx by
+/// ny cells with nx * ny = spp and nx the largest divisor of spp that is at
+/// most sqrt(spp) (a square for 1, 4, 9, 16 ...; 2 x 4 for 8; 1 x spp for a
+/// prime).
+struct StrataGrid {
+    int nx = 1, ny = 1;
+};
+StrataGrid strata_grid(int spp);
+
+/// Sample `index` (0 <= index < spp) of pixel `pixel` in the 2D dimension
+/// `dimension` (0 = position in the pixel, then lens, light, lobe, time ...
+/// as the integrator numbers them).
+class Sampler {
+public:
+    Sampler(SamplerKind kind, int spp, std::uint64_t seed);
+
+    Sample2 get(std::uint64_t pixel, int index, int dimension) const;
+
+    SamplerKind kind() const { return kind_; }
+    int spp() const { return spp_; }
+
+private:
+    SamplerKind kind_;
+    int spp_;
+    std::uint64_t seed_;
+    StrataGrid grid_;
+};
+
+}  // namespace raypack
