@@ -82,6 +82,12 @@ int run_render(const Args& args) {
     auto t0 = std::chrono::steady_clock::now();
     const Scene scene = load_scene(scene_spec);
     const double load_ms = ms_since(t0);
+    // The Whitted integrator does not model these yet (docs/scene-format.md):
+    // refuse rather than render a picture that silently drops them.
+    const Features& f = scene.features;
+    if (f.area_lights || f.distant_lights || f.thin_lens || f.glossy)
+        throw SceneError(scene.source, 0,
+                         "uses la/ls/ld lights, lens or gloss, which the Whitted renderer does not render yet");
     options.width = int(p.integer("--res", scene.camera.width, 1, 65536, 0));
     options.height = int(p.integer("--res", scene.camera.height, 1, 65536, 1));
     if (std::uint64_t(options.width) * std::uint64_t(options.height) > (1ull << 28))
