@@ -264,11 +264,7 @@ double time_shadow_pass(const Scene& scene, const Accel& accel, const RayOffset&
         for (std::size_t i = b; i < end; ++i) {
             const Surface s = surface_at(scene, camera[i], hits[i]);
             const Vec3f n = dot(s.geometric_normal, camera[i].dir) < 0 ? s.geometric_normal : -s.geometric_normal;
-            Rayf& r = shadow[i];
-            r.org = offset.offset(offset.hit_point(scene, camera[i], hits[i], s.point), n);
-            r.dir = light - r.org;
-            r.tnear = offset.tnear();
-            r.tfar = 1.0f - 1e-6f;
+            spawn_ray_to(offset.offset(offset.hit_point(scene, camera[i], hits[i], s.point), n), light, offset, shadow[i]);
         }
         accel.occluded({shadow.data() + b, end - b}, {occluded.data() + b, end - b});
     });

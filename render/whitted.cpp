@@ -1,41 +1,131 @@
 #include "render/whitted.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <utility>
+#include <memory>
 #include <vector>
 
 #include "render/camera_rays.h"
 #include "render/surface.h"
+#include "render/tiles.h"
 
 namespace raypack {
+
+RenderStats& RenderStats::operator+=(const RenderStats& o) {
+    eye_rays += o.eye_rays;
+    eye_hits += o.eye_hits;
+    reflect_rays += o.reflect_rays;
+    refract_rays += o.refract_rays;
+    shadow_rays += o.shadow_rays;
+    return *this;
+}
+
 namespace {
 
-class WhittedTracer {
+/// The ray tree of one batch of eye rays, stored level by level: the rays of
+/// depth d occupy [level_begin, level_end) and their children are appended
+/// after them. Each ray keeps its local colour (ambient and direct light)
+/// and its children; once the deepest level is shaded, colours are summed
+/// bottom-up in the order the recursive tracer added them, so the result is
+/// the recursion's bit for bit.
+struct RayTree {
+    std::vector<Rayf> rays;
+    std::vector<Hitf> hits;
+    std::vector<Vec3f> color;
+    std::vector<std::int32_t> reflect, refract;  ///< child indices, -1 if none
+    std::vector<float> ks, kt;                   ///< weights of the children (kt: 0 if not transmitting)
+
+    void clear() {
+        rays.clear();
+        hits.clear();
+        color.clear();
+        reflect.clear();
+        refract.clear();
+        ks.clear();
+        kt.clear();
+    }
+    /// A new ray (set by the caller through the returned index).
+    std::int32_t add() {
+        rays.emplace_back();
+        hits.emplace_back();
+        color.emplace_back();
+        reflect.push_back(-1);
+        refract.push_back(-1);
+        ks.push_back(0);
+        kt.push_back(0);
+        return std::int32_t(rays.size() - 1);
+    }
+};
+
+/// Shadow rays of one level, grouped by light (rays toward one light
+/// converge on it, so a packet of them is coherent), each with the ray it
+/// lights and the light's contribution should it be unoccluded.
+struct ShadowBatch {
+    std::vector<std::vector<Rayf>> rays;        ///< per light
+    std::vector<std::vector<std::int32_t>> owner;
+    std::vector<std::vector<Vec3f>> contribution;
+    std::vector<Rayf> all;
+    std::vector<std::uint8_t> occluded;
+
+    void reset(std::size_t lights) {
+        rays.resize(lights);
+        owner.resize(lights);
+        contribution.resize(lights);
+        for (std::size_t l = 0; l < lights; ++l) {
+            rays[l].clear();
+            owner[l].clear();
+            contribution[l].clear();
+        }
+    }
+};
+
+struct Scratch {
+    RayTree tree;
+    ShadowBatch shadows;
+    std::vector<Rayf> eye;
+    std::vector<Vec3f> colors;
+    std::vector<PixelXY> pixels;
+    RenderStats stats;
+};
+
+class WhittedWavefront {
 public:
-    WhittedTracer(const Scene& scene, const Accel& accel, const WhittedOptions& options)
+    WhittedWavefront(const Scene& scene, const Accel& accel, const WhittedOptions& options)
         : scene_(scene), accel_(accel), options_(options), offset_(options.offset, scene) {
         // SPD Readme: each light and the ambient term get sqrt(L) / (2 L).
         const float n = float(std::max<std::size_t>(scene.lights.size(), 1));
         intensity_ = std::sqrt(n) / (2.0f * n);
     }
 
-    Vec3f trace(const Rayf& ray, int depth, RenderStats& stats) const {
-        return shade_hit(ray, accel_.intersect1(ray), depth, stats);
-    }
-
-    /// Colour along `ray` whose closest hit is already known.
-    Vec3f shade_hit(const Rayf& ray, const Hitf& hit, int depth, RenderStats& stats) const {
-        if (depth == 1) {
-            ++stats.eye_rays;
-            stats.eye_hits += hit.found();
+    /// Colours of `eye` rays (depth 1): traces the whole ray tree of the batch.
+    void trace(std::span<const Rayf> eye, std::span<Vec3f> colors, Scratch& s) const {
+        RayTree& tree = s.tree;
+        tree.clear();
+        for (const Rayf& r : eye) tree.rays[std::size_t(tree.add())] = r;
+        accel_.intersect_packets(options_.packet, tree.rays, tree.hits);
+        std::size_t begin = 0, end = tree.rays.size();
+        for (int depth = 1; begin < end; ++depth) {
+            if (depth > 1)
+                accel_.intersect_packets(options_.secondary_packet, std::span(tree.rays).subspan(begin, end - begin),
+                                         std::span(tree.hits).subspan(begin, end - begin));
+            shade_level(begin, end, depth, s);
+            begin = end;
+            end = tree.rays.size();
         }
-        if (!hit.found()) return scene_.background;
-        return shade(ray, hit, depth, stats);
+        // Children come after their parents: one backward pass sums the tree.
+        for (std::size_t i = tree.rays.size(); i-- > 0;) {
+            Vec3f c = tree.color[i];
+            if (tree.reflect[i] >= 0) c += tree.color[std::size_t(tree.reflect[i])] * tree.ks[i];
+            if (tree.kt[i] > 0) {
+                // Total internal reflection sends the transmitted share along the reflection ray.
+                const std::int32_t t = tree.refract[i] >= 0 ? tree.refract[i] : tree.reflect[i];
+                c += tree.color[std::size_t(t)] * tree.kt[i];
+            }
+            tree.color[i] = c;
+        }
+        std::copy(tree.color.begin(), tree.color.begin() + std::ptrdiff_t(eye.size()), colors.begin());
     }
 
 private:
@@ -45,32 +135,49 @@ private:
     RayOffset offset_;
     float intensity_ = 1;
 
-    Vec3f shade(const Rayf& ray, const Hitf& hit, int depth, RenderStats& stats) const {
-        const Surface s = surface_at(scene_, ray, hit);
-        const Material& m = scene_.materials[s.material];
+    void shade_level(std::size_t begin, std::size_t end, int depth, Scratch& s) const {
+        RayTree& tree = s.tree;
+        ShadowBatch& shadows = s.shadows;
+        shadows.reset(scene_.lights.size());
+        RenderStats& stats = s.stats;
+        for (std::size_t i = begin; i < end; ++i) {
+            const Rayf ray = tree.rays[i];
+            const Hitf hit = tree.hits[i];
+            if (depth == 1) {
+                ++stats.eye_rays;
+                stats.eye_hits += hit.found();
+            }
+            if (!hit.found()) {
+                tree.color[i] = scene_.background;
+                continue;
+            }
+            shade(std::int32_t(i), ray, hit, depth, s);
+        }
+        trace_shadows(s);
+    }
+
+    void shade(std::int32_t i, const Rayf& ray, const Hitf& hit, int depth, Scratch& s) const {
+        RayTree& tree = s.tree;
+        const Surface surf = surface_at(scene_, ray, hit);
+        const Material& m = scene_.materials[surf.material];
         const Vec3f view = normalize(ray.dir);
         // Shade the side the ray arrives on: both normals face the viewer.
-        const bool front = dot(view, s.geometric_normal) < 0;
-        const Vec3f ng = front ? s.geometric_normal : -s.geometric_normal;
-        Vec3f ns = front ? s.shading_normal : -s.shading_normal;
+        const bool front = dot(view, surf.geometric_normal) < 0;
+        const Vec3f ng = front ? surf.geometric_normal : -surf.geometric_normal;
+        Vec3f ns = front ? surf.shading_normal : -surf.shading_normal;
         if (dot(ns, ng) < 0) ns = ng;  // interpolated normal bent past the surface
-        const Vec3f p = offset_.hit_point(scene_, ray, hit, s.point);
+        const Vec3f p = offset_.hit_point(scene_, ray, hit, surf.point);
         const Vec3f above = offset_.offset(p, ng);
 
-        Vec3f color = m.color * (intensity_ * m.kd);  // ambient
-        for (const PointLight& light : scene_.lights) {
+        tree.color[std::size_t(i)] = m.color * (intensity_ * m.kd);  // ambient
+        for (std::size_t li = 0; li < scene_.lights.size(); ++li) {
+            const PointLight& light = scene_.lights[li];
             const Vec3f to_light = light.position - above;
             const float dist = length(to_light);
             const Vec3f l = to_light / dist;
             // SPD protocol: no shadow ray when the surface faces away from the light.
             if (dot(ns, l) <= 0 || dot(ng, l) <= 0) continue;
-            ++stats.shadow_rays;
-            Rayf shadow;
-            shadow.org = above;
-            shadow.dir = to_light;
-            shadow.tnear = offset_.tnear();
-            shadow.tfar = 1.0f - 1e-6f;
-            if (accel_.occluded1(shadow)) continue;
+            ++s.stats.shadow_rays;
             const float atten =
                 1.0f / (options_.atten_c2 * dist * dist + options_.atten_c1 * dist + options_.atten_c0);
             const Vec3f light_color = light.color * (intensity_ * atten);
@@ -78,47 +185,55 @@ private:
             const Vec3f r = ns * (2.0f * dot(ns, l)) - l;  // mirror of l about the normal
             const float rv = std::max(0.0f, -dot(r, view));
             const float specular = m.ks > 0 && rv > 0 ? m.ks * std::pow(rv, m.shine) : 0.0f;
-            color += light_color * m.color * diffuse + light_color * specular;
+            spawn_ray_to(above, light.position, offset_, s.shadows.rays[li].emplace_back());
+            s.shadows.owner[li].push_back(i);
+            s.shadows.contribution[li].push_back(light_color * m.color * diffuse + light_color * specular);
         }
-        if (depth >= options_.max_depth) return color;
+        if (depth >= options_.max_depth) return;
 
         // SPD protocol (Readme, items 8 and 9): reflective and transmitting
         // surfaces both spawn a reflection ray, weighted by Ks; transmitters
         // also spawn a refraction ray unless total internal reflection occurs,
         // in which case the reflection carries the transmitted share as well.
         const Vec3f reflected_dir = view - ns * (2.0f * dot(view, ns));
-        Vec3f reflected{};
         if (m.ks > 0 || m.transmittance > 0) {
-            ++stats.reflect_rays;
-            reflected = trace(secondary(above, reflected_dir), depth + 1, stats);
-            color += reflected * m.ks;
+            ++s.stats.reflect_rays;
+            const std::int32_t child = tree.add();
+            spawn_ray(above, reflected_dir, offset_, tree.rays[std::size_t(child)]);
+            tree.reflect[std::size_t(i)] = child;
+            tree.ks[std::size_t(i)] = m.ks;
         }
         if (m.transmittance > 0) {
+            tree.kt[std::size_t(i)] = m.transmittance;
             // Snell's law; entering when the ray meets the outward side.
             const float eta = front ? 1.0f / m.ior : m.ior;
             const float cos_i = -dot(view, ns);
             const float k = 1.0f - eta * eta * (1.0f - cos_i * cos_i);
             if (k >= 0) {
-                ++stats.refract_rays;
+                ++s.stats.refract_rays;
                 const Vec3f dir = view * eta + ns * (eta * cos_i - std::sqrt(k));
-                color += trace(secondary(offset_.offset(p, -ng), dir), depth + 1, stats) * m.transmittance;
-            } else {
-                color += reflected * m.transmittance;
+                const std::int32_t child = tree.add();
+                spawn_ray(offset_.offset(p, -ng), dir, offset_, tree.rays[std::size_t(child)]);
+                tree.refract[std::size_t(i)] = child;
             }
         }
-        return color;
     }
 
-    Rayf secondary(const Vec3f& org, const Vec3f& dir) const {
-        Rayf r;
-        r.org = org;
-        r.dir = dir;
-        r.tnear = offset_.tnear();
-        return r;
+    /// Traces the level's shadow rays as one batch, light by light, and adds
+    /// the unoccluded contributions in light order, as the recursion did.
+    void trace_shadows(Scratch& s) const {
+        ShadowBatch& b = s.shadows;
+        b.all.clear();
+        for (const auto& rays : b.rays) b.all.insert(b.all.end(), rays.begin(), rays.end());
+        if (b.all.empty()) return;
+        b.occluded.resize(b.all.size());
+        accel_.occluded_packets(options_.secondary_packet, b.all, b.occluded);
+        std::size_t k = 0;
+        for (std::size_t l = 0; l < b.rays.size(); ++l)
+            for (std::size_t j = 0; j < b.rays[l].size(); ++j, ++k)
+                if (!b.occluded[k]) s.tree.color[std::size_t(b.owner[l][j])] += b.contribution[l][j];
     }
 };
-
-void add(std::atomic<std::uint64_t>& a, std::uint64_t v) { a.fetch_add(v, std::memory_order_relaxed); }
 
 }  // namespace
 
@@ -126,57 +241,43 @@ RenderStats render_whitted(const Scene& scene, const Accel& accel, const Whitted
     const auto start = std::chrono::steady_clock::now();
     image = Image(options.width, options.height);
     const CameraFrame frame = make_camera_frame(scene.camera, options.width, options.height);
-    const WhittedTracer tracer(scene, accel, options);
-    std::atomic<std::uint64_t> eye{0}, eye_hits{0}, reflect{0}, refract{0}, shadow{0};
-    // Tiles of 16 x 16 pixels whose camera rays are ordered in 4 x 4 blocks,
-    // so that each packet of up to 16 consecutive rays covers a compact
-    // patch of the image.
-    constexpr int kTile = 16, kBlock = 4;
-    const int tiles_x = (options.width + kTile - 1) / kTile, tiles_y = (options.height + kTile - 1) / kTile;
-    tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y), [&](const tbb::blocked_range<int>& r) {
-        RenderStats local;
-        std::vector<Rayf> rays;
-        std::vector<Hitf> hits;
-        std::vector<std::pair<int, int>> pixels;
-        for (int tile = r.begin(); tile < r.end(); ++tile) {
-            const int x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
-            rays.clear();
-            pixels.clear();
-            for (int by = y0; by < std::min(y0 + kTile, options.height); by += kBlock)
-                for (int bx = x0; bx < std::min(x0 + kTile, options.width); bx += kBlock)
-                    for (int y = by; y < std::min(by + kBlock, options.height); ++y)
-                        for (int x = bx; x < std::min(bx + kBlock, options.width); ++x) {
-                            rays.push_back(camera_ray(frame, float(x) + 0.5f, float(y) + 0.5f));
-                            pixels.emplace_back(x, y);
-                        }
-            hits.resize(rays.size());
-            accel.intersect_packets(options.packet, rays, hits);
-            for (std::size_t i = 0; i < rays.size(); ++i)
-                image.set(pixels[i].first, pixels[i].second, tracer.shade_hit(rays[i], hits[i], 1, local));
-        }
-        add(eye, local.eye_rays);
-        add(eye_hits, local.eye_hits);
-        add(reflect, local.reflect_rays);
-        add(refract, local.refract_rays);
-        add(shadow, local.shadow_rays);
+    const WhittedWavefront tracer(scene, accel, options);
+    const TileGrid grid{options.width, options.height, 16};
+    std::vector<std::unique_ptr<Scratch>> scratch(static_cast<std::size_t>(worker_slots()));
+    std::atomic<std::uint64_t> pixels_done{0};
+    const std::uint64_t pixels_total = std::uint64_t(options.width) * std::uint64_t(options.height);
+    for_each_tile(grid, [&](int tile, int slot) {
+        auto& mine = scratch[std::size_t(slot)];
+        if (!mine) mine = std::make_unique<Scratch>();
+        Scratch& s = *mine;
+        grid.pixels(tile, s.pixels);
+        s.eye.clear();
+        for (const PixelXY& px : s.pixels) s.eye.push_back(camera_ray(frame, float(px.x) + 0.5f, float(px.y) + 0.5f));
+        s.colors.resize(s.eye.size());
+        tracer.trace(s.eye, s.colors, s);
+        for (std::size_t i = 0; i < s.pixels.size(); ++i) image.set(s.pixels[i].x, s.pixels[i].y, s.colors[i]);
+        const std::uint64_t done = pixels_done.fetch_add(s.pixels.size(), std::memory_order_relaxed) + s.pixels.size();
+        if (options.progress) options.progress(options.progress_context, done, pixels_total);
     });
     RenderStats stats;
-    stats.eye_rays = eye;
-    stats.eye_hits = eye_hits;
-    stats.reflect_rays = reflect;
-    stats.refract_rays = refract;
-    stats.shadow_rays = shadow;
+    for (const auto& s : scratch)
+        if (s) stats += s->stats;
     stats.render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return stats;
 }
 
-}  // namespace raypack
-
-namespace raypack {
+void whitted_radiance(const Scene& scene, const Accel& accel, const WhittedOptions& options,
+                      std::span<const Rayf> rays, std::span<Vec3f> colors, RenderStats& stats) {
+    Scratch s;
+    WhittedWavefront(scene, accel, options).trace(rays, colors, s);
+    stats += s.stats;
+}
 
 Vec3f whitted_radiance(const Scene& scene, const Accel& accel, const WhittedOptions& options, const Rayf& ray) {
+    Vec3f color;
     RenderStats stats;
-    return WhittedTracer(scene, accel, options).trace(ray, 1, stats);
+    whitted_radiance(scene, accel, options, {&ray, 1}, {&color, 1}, stats);
+    return color;
 }
 
 }  // namespace raypack

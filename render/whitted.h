@@ -1,7 +1,10 @@
 #pragma once
-// Whitted-style recursive ray tracing (Whitted, "An Improved Illumination
-// Model for Shaded Display", CACM 1980) with NFF's shading parameters.
+// Whitted ray tracing (Whitted, "An Improved Illumination Model for Shaded
+// Display", CACM 1980) with NFF's shading parameters, traced as a wavefront:
+// per tile, every ray of one depth is a batch through the structure's packet
+// queries, and the recursion of the model becomes iteration over depth.
 #include <cstdint>
+#include <span>
 
 #include "accel/accel.h"
 #include "render/image.h"
@@ -18,10 +21,15 @@ struct WhittedOptions {
     float atten_c0 = 1, atten_c1 = 0, atten_c2 = 0;
     /// How secondary-ray origins move off the surface (render/ray_offset.h).
     OffsetPolicy offset = kDefaultOffset;
-    int tile_size = 16;
-    /// Primary rays are traced as packets of this width (1, 4, 8, 16), each
-    /// covering a compact block of pixels; secondary rays go one by one.
+    /// Eye rays are traced as packets of this width (1, 4, 8, 16), each
+    /// covering a compact block of pixels.
     int packet = 1;
+    /// Reflection, refraction and shadow rays: packets of this width.
+    int secondary_packet = 1;
+    /// Called after each finished tile with the number of pixels done so far
+    /// (from any thread; for progress reports). May be empty.
+    void (*progress)(void* context, std::uint64_t pixels_done, std::uint64_t pixels_total) = nullptr;
+    void* progress_context = nullptr;
 };
 
 /// Ray counts in the SPD Readme's terms, to compare with its statistics table.
@@ -32,11 +40,18 @@ struct RenderStats {
     std::uint64_t refract_rays = 0;
     std::uint64_t shadow_rays = 0;
     double render_ms = 0;
+
+    std::uint64_t total_rays() const { return eye_rays + reflect_rays + refract_rays + shadow_rays; }
+    RenderStats& operator+=(const RenderStats& o);
 };
 
 /// Renders one sample per pixel centre, tiles in parallel with oneTBB (the
 /// caller limits threads with tbb::global_control).
 RenderStats render_whitted(const Scene& scene, const Accel& accel, const WhittedOptions& options, Image& image);
+
+/// Colour seen along each of `rays` (depth 1), traced as one wavefront.
+void whitted_radiance(const Scene& scene, const Accel& accel, const WhittedOptions& options,
+                      std::span<const Rayf> rays, std::span<Vec3f> colors, RenderStats& stats);
 
 /// Colour seen along one ray (depth 1), for tests and tools.
 Vec3f whitted_radiance(const Scene& scene, const Accel& accel, const WhittedOptions& options, const Rayf& ray);
