@@ -242,7 +242,7 @@ RenderStats render_whitted(const Scene& scene, const Accel& accel, const Whitted
     image = Image(options.width, options.height);
     const CameraFrame frame = make_camera_frame(scene.camera, options.width, options.height);
     const WhittedWavefront tracer(scene, accel, options);
-    const TileGrid grid{options.width, options.height, 16};
+    const TileGrid grid{options.width, options.height, options.tile_size};
     std::vector<std::unique_ptr<Scratch>> scratch(static_cast<std::size_t>(worker_slots()));
     std::atomic<std::uint64_t> pixels_done{0};
     const std::uint64_t pixels_total = std::uint64_t(options.width) * std::uint64_t(options.height);

@@ -26,6 +26,8 @@ struct WhittedOptions {
     int packet = 1;
     /// Reflection, refraction and shadow rays: packets of this width.
     int secondary_packet = 1;
+    /// Pixels per tile side: a tile's rays of one depth form one batch.
+    int tile_size = 16;
     /// Called after each finished tile with the number of pixels done so far
     /// (from any thread; for progress reports). May be empty.
     void (*progress)(void* context, std::uint64_t pixels_done, std::uint64_t pixels_total) = nullptr;

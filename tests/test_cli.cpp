@@ -5,6 +5,7 @@
 #include "tests/test_paths.h"
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -77,6 +78,39 @@ TEST(Cli, RenderWritesTheImageAndSaysWhere) {
     EXPECT_TRUE(fs::exists(out));
     EXPECT_NE(r.output.find("64x48"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find(out.string()), std::string::npos);
+}
+
+TEST(Cli, RenderJsonReportsTimesRaysAndThroughput) {
+    const fs::path out = temp_dir() / "balls.png";
+    const Result r = run("render gen:balls:2 -o " + out.string() + " --res 80 60 --threads 1 --json");
+    ASSERT_EQ(r.status, 0) << r.output;
+    // One line, nothing else (stdout is a pipe: no progress line either).
+    ASSERT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+    const nlohmann::json j = nlohmann::json::parse(r.output);
+    EXPECT_EQ(j["integrator"], "whitted");
+    EXPECT_EQ(j["width"], 80);
+    EXPECT_EQ(j["height"], 60);
+    EXPECT_EQ(j["spp"], 1);
+    EXPECT_EQ(j["threads"], 1);
+    for (const char* k : {"load_ms", "build_ms", "render_ms", "write_ms"}) EXPECT_GE(j[k].get<double>(), 0.0) << k;
+    const auto& rays = j["rays"];
+    EXPECT_EQ(rays["eye"], 80 * 60);
+    EXPECT_GT(rays["shadow"].get<std::uint64_t>(), 0u);
+    EXPECT_GT(rays["reflect"].get<std::uint64_t>(), 0u);  // balls: the spheres are mirrors
+    EXPECT_EQ(rays["refract"], 0);
+    const double total = rays["eye"].get<double>() + rays["shadow"].get<double>() + rays["reflect"].get<double>() +
+                         rays["refract"].get<double>();
+    EXPECT_NEAR(j["mrays_per_s"].get<double>(), total / (j["render_ms"].get<double>() * 1e3), 1e-9 * total);
+    EXPECT_TRUE(fs::exists(out));
+}
+
+TEST(Cli, RenderQuietPrintsNothing) {
+    const fs::path out = temp_dir() / "tetra.png";
+    fs::remove(out);
+    const Result r = run("render gen:tetra:3 -o " + out.string() + " --res 32 32 --quiet");
+    EXPECT_EQ(r.status, 0);
+    EXPECT_EQ(r.output, "");
+    EXPECT_TRUE(fs::exists(out));
 }
 
 TEST(Cli, TraceAnswersClosestAndAnyHitWithJson) {
