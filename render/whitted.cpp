@@ -36,26 +36,38 @@ struct RayTree {
     std::vector<Vec3f> color;
     std::vector<std::int32_t> reflect, refract;  ///< child indices, -1 if none
     std::vector<float> ks, kt;                   ///< weights of the children (kt: 0 if not transmitting)
+    std::size_t count = 0;                       ///< rays in use; the arrays only grow
 
-    void clear() {
-        rays.clear();
-        hits.clear();
-        color.clear();
-        reflect.clear();
-        refract.clear();
-        ks.clear();
-        kt.clear();
+    /// Starts a tree of `eye` rays (to be written to rays[0 .. eye)).
+    void reset(std::size_t eye) {
+        count = 0;
+        reserve(eye);
+        for (std::size_t i = 0; i < eye; ++i) init(i);
+        count = eye;
     }
     /// A new ray (set by the caller through the returned index).
     std::int32_t add() {
-        rays.emplace_back();
-        hits.emplace_back();
-        color.emplace_back();
-        reflect.push_back(-1);
-        refract.push_back(-1);
-        ks.push_back(0);
-        kt.push_back(0);
-        return std::int32_t(rays.size() - 1);
+        reserve(count + 1);
+        init(count);
+        return std::int32_t(count++);
+    }
+
+private:
+    void reserve(std::size_t n) {
+        if (n <= rays.size()) return;
+        const std::size_t size = std::max(n, 2 * rays.size());
+        rays.resize(size);
+        hits.resize(size);
+        color.resize(size);
+        reflect.resize(size);
+        refract.resize(size);
+        ks.resize(size);
+        kt.resize(size);
+    }
+    void init(std::size_t i) {
+        hits[i] = Hitf{};
+        reflect[i] = refract[i] = -1;
+        ks[i] = kt[i] = 0;
     }
 };
 
@@ -84,8 +96,6 @@ struct ShadowBatch {
 struct Scratch {
     RayTree tree;
     ShadowBatch shadows;
-    std::vector<Rayf> eye;
-    std::vector<Vec3f> colors;
     std::vector<PixelXY> pixels;
     RenderStats stats;
 };
@@ -99,23 +109,22 @@ public:
         intensity_ = std::sqrt(n) / (2.0f * n);
     }
 
-    /// Colours of `eye` rays (depth 1): traces the whole ray tree of the batch.
-    void trace(std::span<const Rayf> eye, std::span<Vec3f> colors, Scratch& s) const {
+    /// Traces the whole ray tree of the eye rays s.tree.rays[0 .. eye) (set
+    /// after s.tree.reset(eye)); their colours end in s.tree.color[0 .. eye).
+    void trace(std::size_t eye, Scratch& s) const {
         RayTree& tree = s.tree;
-        tree.clear();
-        for (const Rayf& r : eye) tree.rays[std::size_t(tree.add())] = r;
-        accel_.intersect_packets(options_.packet, tree.rays, tree.hits);
-        std::size_t begin = 0, end = tree.rays.size();
+        accel_.intersect_packets(options_.packet, std::span(tree.rays).first(eye), std::span(tree.hits).first(eye));
+        std::size_t begin = 0, end = eye;
         for (int depth = 1; begin < end; ++depth) {
             if (depth > 1)
                 accel_.intersect_packets(options_.secondary_packet, std::span(tree.rays).subspan(begin, end - begin),
                                          std::span(tree.hits).subspan(begin, end - begin));
             shade_level(begin, end, depth, s);
             begin = end;
-            end = tree.rays.size();
+            end = tree.count;
         }
         // Children come after their parents: one backward pass sums the tree.
-        for (std::size_t i = tree.rays.size(); i-- > 0;) {
+        for (std::size_t i = tree.count; i-- > 0;) {
             Vec3f c = tree.color[i];
             if (tree.reflect[i] >= 0) c += tree.color[std::size_t(tree.reflect[i])] * tree.ks[i];
             if (tree.kt[i] > 0) {
@@ -125,7 +134,6 @@ public:
             }
             tree.color[i] = c;
         }
-        std::copy(tree.color.begin(), tree.color.begin() + std::ptrdiff_t(eye.size()), colors.begin());
     }
 
 private:
@@ -251,11 +259,12 @@ RenderStats render_whitted(const Scene& scene, const Accel& accel, const Whitted
         if (!mine) mine = std::make_unique<Scratch>();
         Scratch& s = *mine;
         grid.pixels(tile, s.pixels);
-        s.eye.clear();
-        for (const PixelXY& px : s.pixels) s.eye.push_back(camera_ray(frame, float(px.x) + 0.5f, float(px.y) + 0.5f));
-        s.colors.resize(s.eye.size());
-        tracer.trace(s.eye, s.colors, s);
-        for (std::size_t i = 0; i < s.pixels.size(); ++i) image.set(s.pixels[i].x, s.pixels[i].y, s.colors[i]);
+        const std::size_t n = s.pixels.size();
+        s.tree.reset(n);
+        for (std::size_t i = 0; i < n; ++i)
+            s.tree.rays[i] = camera_ray(frame, float(s.pixels[i].x) + 0.5f, float(s.pixels[i].y) + 0.5f);
+        tracer.trace(n, s);
+        for (std::size_t i = 0; i < n; ++i) image.set(s.pixels[i].x, s.pixels[i].y, s.tree.color[i]);
         const std::uint64_t done = pixels_done.fetch_add(s.pixels.size(), std::memory_order_relaxed) + s.pixels.size();
         if (options.progress) options.progress(options.progress_context, done, pixels_total);
     });
@@ -269,7 +278,10 @@ RenderStats render_whitted(const Scene& scene, const Accel& accel, const Whitted
 void whitted_radiance(const Scene& scene, const Accel& accel, const WhittedOptions& options,
                       std::span<const Rayf> rays, std::span<Vec3f> colors, RenderStats& stats) {
     Scratch s;
-    WhittedWavefront(scene, accel, options).trace(rays, colors, s);
+    s.tree.reset(rays.size());
+    std::copy(rays.begin(), rays.end(), s.tree.rays.begin());
+    WhittedWavefront(scene, accel, options).trace(rays.size(), s);
+    std::copy(s.tree.color.begin(), s.tree.color.begin() + std::ptrdiff_t(rays.size()), colors.begin());
     stats += s.stats;
 }
 
