@@ -8,7 +8,10 @@
 #include <vector>
 
 #include "render/camera_rays.h"
+#include "render/light_sampling.h"
+#include "render/sampling.h"
 #include "render/surface.h"
+#include "render/thin_lens.h"
 #include "render/tiles.h"
 
 namespace raypack {
@@ -36,6 +39,7 @@ struct RayTree {
     std::vector<Vec3f> color;
     std::vector<std::int32_t> reflect, refract;  ///< child indices, -1 if none
     std::vector<float> ks, kt;                   ///< weights of the children (kt: 0 if not transmitting)
+    std::vector<std::uint64_t> sample;           ///< pixel * spp + sample index of the camera sample
     std::size_t count = 0;                       ///< rays in use; the arrays only grow
 
     /// Starts a tree of `eye` rays (to be written to rays[0 .. eye)).
@@ -63,6 +67,7 @@ private:
         refract.resize(size);
         ks.resize(size);
         kt.resize(size);
+        sample.resize(size);
     }
     void init(std::size_t i) {
         hits[i] = Hitf{};
@@ -82,10 +87,12 @@ struct ShadowBatch {
     std::vector<std::uint8_t> occluded;
 
     void reset(std::size_t lights) {
-        rays.resize(lights);
-        owner.resize(lights);
-        contribution.resize(lights);
-        for (std::size_t l = 0; l < lights; ++l) {
+        if (rays.size() < lights) {
+            rays.resize(lights);
+            owner.resize(lights);
+            contribution.resize(lights);
+        }
+        for (std::size_t l = 0; l < rays.size(); ++l) {
             rays[l].clear();
             owner[l].clear();
             contribution[l].clear();
@@ -103,10 +110,34 @@ struct Scratch {
 class WhittedWavefront {
 public:
     WhittedWavefront(const Scene& scene, const Accel& accel, const WhittedOptions& options)
-        : scene_(scene), accel_(accel), options_(options), offset_(options.offset, scene) {
-        // SPD Readme: each light and the ambient term get sqrt(L) / (2 L).
-        const float n = float(std::max<std::size_t>(scene.lights.size(), 1));
-        intensity_ = std::sqrt(n) / (2.0f * n);
+        : scene_(scene),
+          accel_(accel),
+          options_(options),
+          offset_(options.offset, scene),
+          // SPD Readme: each light and the ambient term get sqrt(L) / (2 L),
+          // L counting lights of every kind.
+          intensity_(scene.spd_light_intensity()),
+          samples_(options.distribution ? options.sampler : SamplerKind::Regular,
+                   options.distribution ? options.spp : 1, options.seed),
+          light_samples_(options.distribution ? options.sampler : SamplerKind::Regular,
+                         options.distribution ? options.light_samples : 1, options.seed ^ 0x5bd1e995ull) {}
+
+    /// Light buckets: point lights, then distant lights, then area lights.
+    std::size_t light_buckets() const {
+        return scene_.lights.size() + scene_.distant_lights.size() + scene_.area_lights.size();
+    }
+
+    /// Position in the image of camera sample `index` of pixel (x, y): the
+    /// pixel's centre for Whitted, else drawn from the pixel filter.
+    void camera_sample(int x, int y, int index, Rayf& ray, const CameraFrame& frame) const {
+        if (!options_.distribution) {
+            ray = camera_ray(frame, float(x) + 0.5f, float(y) + 0.5f);
+            return;
+        }
+        const std::uint64_t pixel = std::uint64_t(y) * std::uint64_t(options_.width) + std::uint64_t(x);
+        const Sample2 off = filter_offset(options_.filter, samples_.get(pixel, index, 0));
+        ray = thin_lens_ray(frame, float(x) + 0.5f + off.x, float(y) + 0.5f + off.y, samples_.get(pixel, index, 1),
+                            scene_.camera.lens_radius, scene_.camera.focus_distance);
     }
 
     /// Traces the whole ray tree of the eye rays s.tree.rays[0 .. eye) (set
@@ -142,11 +173,13 @@ private:
     const WhittedOptions& options_;
     RayOffset offset_;
     float intensity_ = 1;
+    Sampler samples_;        ///< camera samples: pixel position, lens, glossy lobes
+    Sampler light_samples_;  ///< points on area lights
 
     void shade_level(std::size_t begin, std::size_t end, int depth, Scratch& s) const {
         RayTree& tree = s.tree;
         ShadowBatch& shadows = s.shadows;
-        shadows.reset(scene_.lights.size());
+        shadows.reset(light_buckets());
         RenderStats& stats = s.stats;
         for (std::size_t i = begin; i < end; ++i) {
             const Rayf ray = tree.rays[i];
@@ -168,6 +201,11 @@ private:
         RayTree& tree = s.tree;
         const Surface surf = surface_at(scene_, ray, hit);
         const Material& m = scene_.materials[surf.material];
+        if (m.area_light >= 0) {
+            // A light's own surface shows the light's colour.
+            tree.color[std::size_t(i)] = scene_.area_lights[std::size_t(m.area_light)].color;
+            return;
+        }
         const Vec3f view = normalize(ray.dir);
         // Shade the side the ray arrives on: both normals face the viewer.
         const bool front = dot(view, surf.geometric_normal) < 0;
@@ -188,14 +226,42 @@ private:
             ++s.stats.shadow_rays;
             const float atten =
                 1.0f / (options_.atten_c2 * dist * dist + options_.atten_c1 * dist + options_.atten_c0);
-            const Vec3f light_color = light.color * (intensity_ * atten);
-            const float diffuse = m.kd * dot(ns, l);
-            const Vec3f r = ns * (2.0f * dot(ns, l)) - l;  // mirror of l about the normal
-            const float rv = std::max(0.0f, -dot(r, view));
-            const float specular = m.ks > 0 && rv > 0 ? m.ks * std::pow(rv, m.shine) : 0.0f;
             spawn_ray_to(above, light.position, offset_, s.shadows.rays[li].emplace_back());
             s.shadows.owner[li].push_back(i);
-            s.shadows.contribution[li].push_back(light_color * m.color * diffuse + light_color * specular);
+            s.shadows.contribution[li].push_back(direct(m, light.color * (intensity_ * atten), ns, l, view));
+        }
+        std::size_t bucket = scene_.lights.size();
+        for (const DistantLight& light : scene_.distant_lights) {
+            const Vec3f l = -light.direction;
+            if (dot(ns, l) > 0 && dot(ng, l) > 0) {
+                ++s.stats.shadow_rays;
+                spawn_ray(above, l, offset_, s.shadows.rays[bucket].emplace_back());
+                s.shadows.owner[bucket].push_back(i);
+                s.shadows.contribution[bucket].push_back(direct(m, light.color * intensity_, ns, l, view));
+            }
+            ++bucket;
+        }
+        // Area lights: the SPD intensity spread evenly over the light's area,
+        // i.e. the mean of point lights at stratified points of it, each
+        // shining from the emitting side only.
+        const int n_light = light_samples_.spp();
+        for (std::size_t a = 0; a < scene_.area_lights.size(); ++a, ++bucket) {
+            const AreaLight& light = scene_.area_lights[a];
+            const Vec3f share = light.color * (intensity_ / float(n_light));
+            for (int j = 0; j < n_light; ++j) {
+                Sample2 u = light_samples_.get(tree.sample[std::size_t(i)], j, depth * 64 + int(a % 64));
+                if (!options_.distribution && light.shape == AreaLightShape::Sphere) u = {0, 0};  // the facing point
+                const LightSample ls = sample_area_light(light, above, u);
+                const Vec3f to_light = ls.point - above;
+                const float dist = length(to_light);
+                if (!(dist > 0) || dot(ls.normal, to_light) >= 0) continue;  // behind the emitting side
+                const Vec3f l = to_light / dist;
+                if (dot(ns, l) <= 0 || dot(ng, l) <= 0) continue;
+                ++s.stats.shadow_rays;
+                spawn_ray_to(above, ls.point, offset_, s.shadows.rays[bucket].emplace_back());
+                s.shadows.owner[bucket].push_back(i);
+                s.shadows.contribution[bucket].push_back(direct(m, share, ns, l, view));
+            }
         }
         if (depth >= options_.max_depth) return;
 
@@ -203,10 +269,21 @@ private:
         // surfaces both spawn a reflection ray, weighted by Ks; transmitters
         // also spawn a refraction ray unless total internal reflection occurs,
         // in which case the reflection carries the transmitted share as well.
-        const Vec3f reflected_dir = view - ns * (2.0f * dot(view, ns));
+        Vec3f reflected_dir = view - ns * (2.0f * dot(view, ns));
+        if (options_.distribution && m.gloss > 0) {
+            // Glossy: a direction of the Phong lobe about the mirror direction;
+            // one under the surface falls back to the mirror direction.
+            const std::uint64_t key = tree.sample[std::size_t(i)];
+            const Sample2 u = samples_.get(key / std::uint64_t(samples_.spp()), int(key % std::uint64_t(samples_.spp())),
+                                           1 + depth);
+            const Vec3f mirror = normalize(reflected_dir);
+            const Vec3f d = OrthonormalBasis<float>(mirror).to_world(phong_lobe(m.gloss, u.x, u.y));
+            if (dot(d, ng) > 0) reflected_dir = d;
+        }
         if (m.ks > 0 || m.transmittance > 0) {
             ++s.stats.reflect_rays;
             const std::int32_t child = tree.add();
+            tree.sample[std::size_t(child)] = tree.sample[std::size_t(i)];
             spawn_ray(above, reflected_dir, offset_, tree.rays[std::size_t(child)]);
             tree.reflect[std::size_t(i)] = child;
             tree.ks[std::size_t(i)] = m.ks;
@@ -221,10 +298,22 @@ private:
                 ++s.stats.refract_rays;
                 const Vec3f dir = view * eta + ns * (eta * cos_i - std::sqrt(k));
                 const std::int32_t child = tree.add();
+                tree.sample[std::size_t(child)] = tree.sample[std::size_t(i)];
                 spawn_ray(offset_.offset(p, -ng), dir, offset_, tree.rays[std::size_t(child)]);
                 tree.refract[std::size_t(i)] = child;
             }
         }
+    }
+
+    /// Ambient-free light of one unoccluded light of colour `light_color`
+    /// arriving along unit `l`: Lambert plus the Phong highlight.
+    static Vec3f direct(const Material& m, const Vec3f& light_color, const Vec3f& ns, const Vec3f& l,
+                        const Vec3f& view) {
+        const float diffuse = m.kd * dot(ns, l);
+        const Vec3f r = ns * (2.0f * dot(ns, l)) - l;  // mirror of l about the normal
+        const float rv = std::max(0.0f, -dot(r, view));
+        const float specular = m.ks > 0 && rv > 0 ? m.ks * std::pow(rv, m.shine) : 0.0f;
+        return light_color * m.color * diffuse + light_color * specular;
     }
 
     /// Traces the level's shadow rays as one batch, light by light, and adds
@@ -247,27 +336,44 @@ private:
 
 RenderStats render_whitted(const Scene& scene, const Accel& accel, const WhittedOptions& options, Image& image) {
     const auto start = std::chrono::steady_clock::now();
-    image = Image(options.width, options.height);
     const CameraFrame frame = make_camera_frame(scene.camera, options.width, options.height);
     const WhittedWavefront tracer(scene, accel, options);
+    const int spp = options.distribution ? options.spp : 1;
     const TileGrid grid{options.width, options.height, options.tile_size};
     std::vector<std::unique_ptr<Scratch>> scratch(static_cast<std::size_t>(worker_slots()));
     std::atomic<std::uint64_t> pixels_done{0};
     const std::uint64_t pixels_total = std::uint64_t(options.width) * std::uint64_t(options.height);
+    Film film(options.width, options.height);
+    image = Image(options.width, options.height);
     for_each_tile(grid, [&](int tile, int slot) {
         auto& mine = scratch[std::size_t(slot)];
         if (!mine) mine = std::make_unique<Scratch>();
         Scratch& s = *mine;
         grid.pixels(tile, s.pixels);
-        const std::size_t n = s.pixels.size();
+        // The samples of one pixel are consecutive, so packets of eye rays
+        // stay within a block of neighbouring pixels.
+        const std::size_t n = s.pixels.size() * std::size_t(spp);
         s.tree.reset(n);
-        for (std::size_t i = 0; i < n; ++i)
-            s.tree.rays[i] = camera_ray(frame, float(s.pixels[i].x) + 0.5f, float(s.pixels[i].y) + 0.5f);
+        for (std::size_t i = 0; i < n; ++i) {
+            const PixelXY px = s.pixels[i / std::size_t(spp)];
+            const int index = int(i % std::size_t(spp));
+            tracer.camera_sample(px.x, px.y, index, s.tree.rays[i], frame);
+            s.tree.sample[i] =
+                (std::uint64_t(px.y) * std::uint64_t(options.width) + std::uint64_t(px.x)) * std::uint64_t(spp) +
+                std::uint64_t(index);
+        }
         tracer.trace(n, s);
-        for (std::size_t i = 0; i < n; ++i) image.set(s.pixels[i].x, s.pixels[i].y, s.tree.color[i]);
+        for (std::size_t i = 0; i < n; ++i) {
+            const PixelXY px = s.pixels[i / std::size_t(spp)];
+            if (spp == 1)
+                image.set(px.x, px.y, s.tree.color[i]);  // Whitted: exactly the ray's colour
+            else
+                film.add(px.x, px.y, s.tree.color[i]);
+        }
         const std::uint64_t done = pixels_done.fetch_add(s.pixels.size(), std::memory_order_relaxed) + s.pixels.size();
         if (options.progress) options.progress(options.progress_context, done, pixels_total);
     });
+    if (spp > 1) image = film.resolve();
     RenderStats stats;
     for (const auto& s : scratch)
         if (s) stats += s->stats;
@@ -280,6 +386,7 @@ void whitted_radiance(const Scene& scene, const Accel& accel, const WhittedOptio
     Scratch s;
     s.tree.reset(rays.size());
     std::copy(rays.begin(), rays.end(), s.tree.rays.begin());
+    for (std::size_t i = 0; i < rays.size(); ++i) s.tree.sample[i] = i;
     WhittedWavefront(scene, accel, options).trace(rays.size(), s);
     std::copy(s.tree.color.begin(), s.tree.color.begin() + std::ptrdiff_t(rays.size()), colors.begin());
     stats += s.stats;

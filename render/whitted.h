@@ -1,14 +1,19 @@
 #pragma once
 // Whitted ray tracing (Whitted, "An Improved Illumination Model for Shaded
-// Display", CACM 1980) with NFF's shading parameters, traced as a wavefront:
-// per tile, every ray of one depth is a batch through the structure's packet
-// queries, and the recursion of the model becomes iteration over depth.
+// Display", CACM 1980) with NFF's shading parameters, and its distributed
+// form (Cook, Porter, Carpenter, "Distributed Ray Tracing", SIGGRAPH 1984:
+// samples over the pixel, the lens, area lights and glossy lobes), traced as
+// a wavefront: per tile, every ray of one depth is a batch through the
+// structure's packet queries, and the recursion of the model becomes
+// iteration over depth.
 #include <cstdint>
 #include <span>
 
 #include "accel/accel.h"
+#include "render/film.h"
 #include "render/image.h"
 #include "render/ray_offset.h"
+#include "render/sampler.h"
 #include "scene/scene.h"
 
 namespace raypack {
@@ -28,6 +33,16 @@ struct WhittedOptions {
     int secondary_packet = 1;
     /// Pixels per tile side: a tile's rays of one depth form one batch.
     int tile_size = 16;
+    /// Distribution ray tracing: the effects below are sampled. Off (the
+    /// Whitted integrator), one ray per pixel centre, the lens is a pinhole,
+    /// glossy surfaces are mirrors and each area light is one point light
+    /// (its centre; a sphere's point facing the shaded point).
+    bool distribution = false;
+    int spp = 1;                                   ///< camera samples per pixel
+    SamplerKind sampler = SamplerKind::Stratified;
+    std::uint64_t seed = 1;
+    int light_samples = 1;                         ///< shadow rays per area light per camera sample
+    PixelFilter filter = PixelFilter::Box;
     /// Called after each finished tile with the number of pixels done so far
     /// (from any thread; for progress reports). May be empty.
     void (*progress)(void* context, std::uint64_t pixels_done, std::uint64_t pixels_total) = nullptr;

@@ -1,0 +1,55 @@
+#include "render/film.h"
+
+#include <cmath>
+#include <numbers>
+
+namespace raypack {
+
+std::optional<PixelFilter> pixel_filter_from_name(std::string_view name) {
+    if (name == "box") return PixelFilter::Box;
+    if (name == "tent") return PixelFilter::Tent;
+    if (name == "gaussian") return PixelFilter::Gaussian;
+    return std::nullopt;
+}
+
+const char* pixel_filter_name(PixelFilter filter) {
+    switch (filter) {
+        case PixelFilter::Box: return "box";
+        case PixelFilter::Tent: return "tent";
+        case PixelFilter::Gaussian: return "gaussian";
+    }
+    return "?";
+}
+
+namespace {
+
+/// Inverse of the tent's distribution function on [-1, 1].
+float tent_inverse(float u) { return u < 0.5f ? std::sqrt(2.0f * u) - 1.0f : 1.0f - std::sqrt(2.0f - 2.0f * u); }
+
+}  // namespace
+
+Sample2 filter_offset(PixelFilter filter, Sample2 u) {
+    switch (filter) {
+        case PixelFilter::Box: return {u.x - 0.5f, u.y - 0.5f};
+        case PixelFilter::Tent: return {tent_inverse(u.x), tent_inverse(u.y)};
+        case PixelFilter::Gaussian: {
+            // Box-Muller: one 2D point gives a 2D normal point exactly.
+            const float r = 0.5f * std::sqrt(-2.0f * std::log(1.0f - u.x));
+            const float phi = 2.0f * std::numbers::pi_v<float> * u.y;
+            return {r * std::cos(phi), r * std::sin(phi)};
+        }
+    }
+    return {};
+}
+
+Image Film::resolve() const {
+    Image out(sum_.width, sum_.height);
+    for (int y = 0; y < sum_.height; ++y)
+        for (int x = 0; x < sum_.width; ++x) {
+            const int n = count_[std::size_t(y) * std::size_t(sum_.width) + std::size_t(x)];
+            out.set(x, y, n > 0 ? sum_.at(x, y) / float(n) : Vec3f{});
+        }
+    return out;
+}
+
+}  // namespace raypack

@@ -1,0 +1,189 @@
+// The distribution integrator (render/whitted.h, distribution = true)
+// against closed forms: a pixel cut by an edge converges to the covered
+// fraction, a plane in focus looks the same through the lens as through the
+// pinhole, and the soft shadow of a rendered scene lies between umbra and
+// full light; images do not depend on the thread count.
+#include <gtest/gtest.h>
+
+#include <tbb/global_control.h>
+
+#include <cmath>
+
+#include "accel/accel.h"
+#include "render/whitted.h"
+#include "scene/load.h"
+
+namespace raypack {
+namespace {
+
+/// A camera at the origin looking down -z at the plane z = -10, 32 x 32
+/// pixels; no lights, so a surface shows its ambient colour, 0.5 x its fill
+/// colour (the SPD rule with L = 0 counted as 1).
+Scene plane_scene() {
+    Scene s;
+    s.camera.from = {0, 0, 0};
+    s.camera.at = {0, 0, -1};
+    s.camera.up = {0, 1, 0};
+    s.camera.fov_deg = 30;
+    s.camera.width = s.camera.height = 32;
+    s.has_camera = true;
+    s.background = {0, 0, 0};
+    return s;
+}
+
+WhittedOptions distribution(int spp, SamplerKind sampler) {
+    WhittedOptions o;
+    o.width = o.height = 32;
+    o.distribution = true;
+    o.spp = spp;
+    o.sampler = sampler;
+    return o;
+}
+
+TEST(DistributionRender, PixelCutByAnEdgeConvergesToTheCoveredFraction) {
+    Scene s = plane_scene();
+    s.materials.push_back({});  // white
+    // Image plane step per pixel at unit distance: 2 tan(15 deg) / 31 (NFF's
+    // angle spans the centres of the outer rows). Put the edge x = X at
+    // image column 10.3: pixel 10 is covered over 0.7 of its width.
+    const double step = 2 * std::tan(15 * M_PI / 180) / 31;
+    const float edge = float((10.3 - 16) * step * 10);
+    s.add_triangle({edge, -100, -10}, {100, -100, -10}, {edge, 100, -10}, 0);
+    s.update_features();
+    const auto accel = build_accel(s, AccelConfig{});
+    for (SamplerKind k : {SamplerKind::Stratified, SamplerKind::Sobol, SamplerKind::Random}) {
+        Image image;
+        render_whitted(s, *accel, distribution(1024, k), image);
+        SCOPED_TRACE(sampler_name(k));
+        const double tolerance = k == SamplerKind::Random ? 0.05 : 0.01;
+        for (int y : {3, 16, 28}) {
+            EXPECT_NEAR(image.at(10, y).x, 0.5 * 0.7, 0.5 * tolerance);
+            EXPECT_EQ(image.at(9, y).x, 0.0f);
+            EXPECT_EQ(image.at(11, y).x, 0.5f);
+        }
+    }
+    // Whitted: the pixel centre is covered, so the pixel is fully white.
+    WhittedOptions whitted = distribution(1, SamplerKind::Regular);
+    whitted.distribution = false;
+    Image image;
+    render_whitted(s, *accel, whitted, image);
+    EXPECT_EQ(image.at(10, 16).x, 0.5f);
+}
+
+/// A checkerboard of 1 x 1 squares on the plane z = -10.
+Scene checkerboard() {
+    Scene s = plane_scene();
+    Material black, white;
+    black.color = {0, 0, 0};
+    s.materials = {white, black};
+    for (int i = -6; i < 6; ++i)
+        for (int j = -6; j < 6; ++j) {
+            const float x = float(i), y = float(j);
+            const std::uint32_t m = std::uint32_t((i + j) & 1);
+            s.add_triangle({x, y, -10}, {x + 1, y, -10}, {x + 1, y + 1, -10}, m);
+            s.add_triangle({x, y, -10}, {x + 1, y + 1, -10}, {x, y + 1, -10}, m);
+        }
+    s.update_features();
+    return s;
+}
+
+double mean_abs_difference(const Image& a, const Image& b) {
+    double sum = 0;
+    for (std::size_t i = 0; i < a.rgb.size(); ++i) sum += std::fabs(double(a.rgb[i]) - double(b.rgb[i]));
+    return sum / double(a.rgb.size());
+}
+
+TEST(DistributionRender, APlaneInFocusIsSharpThroughTheLens) {
+    Scene s = checkerboard();
+    const auto accel = build_accel(s, AccelConfig{});
+    const WhittedOptions o = distribution(64, SamplerKind::Stratified);
+    Image pinhole, focused, blurred;
+    render_whitted(s, *accel, o, pinhole);
+    s.camera.lens_radius = 0.5f;
+    s.camera.focus_distance = 10;  // the checkerboard's plane
+    render_whitted(s, *accel, o, focused);
+    s.camera.focus_distance = 5;
+    render_whitted(s, *accel, o, blurred);
+    // The same pixel positions reach the same points of the plane: only
+    // rounding at the squares' edges differs.
+    EXPECT_LT(mean_abs_difference(focused, pinhole), 1e-3);
+    // Out of focus the circle of confusion on the plane has radius
+    // 0.5 |10 - 5| / 5 = 0.5 squares: the edges blur visibly.
+    EXPECT_GT(mean_abs_difference(blurred, pinhole), 0.03);
+}
+
+TEST(DistributionRender, SoftShadowOfAnAreaLightHasUmbraPenumbraAndFullLight) {
+    // The floor z = 0, a strip x in [2, 4] at z = 2 (long in y), a light
+    // x, y in [-1, 1] at z = 4 facing down. A floor point x_f sees light
+    // point x_l past the strip unless (x_f + x_l) / 2 is in [2, 4]: umbra
+    // for x_f in [5, 7], penumbra in [3, 5] (half the light at x_f = 4).
+    Scene s = plane_scene();
+    s.camera.from = {0, 0, 20};
+    s.camera.at = {0, 0, 0};
+    s.camera.fov_deg = 60;
+    s.camera.width = s.camera.height = 64;
+    s.materials.push_back({});
+    s.add_triangle({-50, -50, 0}, {50, -50, 0}, {50, 50, 0}, 0);
+    s.add_triangle({-50, -50, 0}, {50, 50, 0}, {-50, 50, 0}, 0);
+    s.add_triangle({2, -30, 2}, {4, -30, 2}, {4, 30, 2}, 0);
+    s.add_triangle({2, -30, 2}, {4, 30, 2}, {2, 30, 2}, 0);
+    AreaLight light;
+    light.corner = {-1, -1, 4};
+    light.edge1 = {0, 2, 0};
+    light.edge2 = {2, 0, 0};  // e x f = (0, 0, -4): facing down
+    s.area_lights.push_back(light);
+    s.update_features();
+    const auto accel = build_accel(s, AccelConfig{});
+    WhittedOptions o = distribution(16, SamplerKind::Stratified);
+    o.light_samples = 16;
+    o.width = o.height = 64;
+    Image image;
+    render_whitted(s, *accel, o, image);
+    // Column c's centre sees the floor at x = (c + 0.5 - 32) 20 step.
+    const double step = 2 * std::tan(M_PI / 6) / 63;
+    const auto floor_x = [&](int c) { return (c + 0.5 - 32) * 20 * step; };
+    const auto column = [&](double x) { return int(std::lround(x / (20 * step) + 31.5)); };
+    // Ambient 0.5 (one light: sqrt(1) / 2) plus 0.5 kd cos per visible light
+    // point, averaged over the light (midpoint rule).
+    const auto expected = [&](double xf) {
+        double sum = 0;
+        const int n = 400;
+        for (int i = 0; i < n; ++i)
+            for (int j = 0; j < n; ++j) {
+                const double xl = -1 + 2 * (i + 0.5) / n, yl = -1 + 2 * (j + 0.5) / n;
+                const double mid = (xf + xl) / 2;
+                if (mid >= 2 && mid <= 4) continue;
+                sum += 4 / std::sqrt((xl - xf) * (xl - xf) + yl * yl + 16);
+            }
+        return 0.5 + 0.5 * sum / (n * n);
+    };
+    const int row = 31;  // the floor's y = -0.18 there: close enough to the strip's middle
+    for (double x : {6.0 /* umbra */, 8.0 /* penumbra: half the light */, 7.4, 8.6, -5.0 /* full light */}) {
+        const int c = column(x);
+        // Seen past the strip: the camera ray crosses z = 2 at 0.9 x.
+        ASSERT_FALSE(0.9 * floor_x(c) >= 2 && 0.9 * floor_x(c) <= 4);
+        EXPECT_NEAR(image.at(c, row).x, expected(floor_x(c)), 0.03) << "floor x " << floor_x(c);
+    }
+    EXPECT_NEAR(image.at(column(6), row).x, 0.5f, 1e-6f);  // umbra: ambient alone
+}
+
+TEST(DistributionRender, SameImageForAnyThreadCount) {
+    const Scene s = load_scene("gen:cornell:2");
+    const auto accel = build_accel(s, AccelConfig{});
+    WhittedOptions o = distribution(8, SamplerKind::Sobol);
+    o.width = o.height = 48;
+    o.light_samples = 2;
+    Image one, two;
+    {
+        const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+        render_whitted(s, *accel, o, one);
+    }
+    {
+        const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+        render_whitted(s, *accel, o, two);
+    }
+    EXPECT_EQ(one.rgb, two.rgb);
+}
+
+}  // namespace
+}  // namespace raypack
