@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "render/camera_rays.h"
@@ -343,7 +344,8 @@ RenderStats render_whitted(const Scene& scene, const Accel& accel, const Whitted
     std::vector<std::unique_ptr<Scratch>> scratch(static_cast<std::size_t>(worker_slots()));
     std::atomic<std::uint64_t> pixels_done{0};
     const std::uint64_t pixels_total = std::uint64_t(options.width) * std::uint64_t(options.height);
-    Film film(options.width, options.height);
+    std::optional<Film> film;  // Whitted writes the image directly
+    if (spp > 1) film.emplace(options.width, options.height);
     image = Image(options.width, options.height);
     for_each_tile(grid, [&](int tile, int slot) {
         auto& mine = scratch[std::size_t(slot)];
@@ -354,26 +356,27 @@ RenderStats render_whitted(const Scene& scene, const Accel& accel, const Whitted
         // stay within a block of neighbouring pixels.
         const std::size_t n = s.pixels.size() * std::size_t(spp);
         s.tree.reset(n);
-        for (std::size_t i = 0; i < n; ++i) {
-            const PixelXY px = s.pixels[i / std::size_t(spp)];
-            const int index = int(i % std::size_t(spp));
-            tracer.camera_sample(px.x, px.y, index, s.tree.rays[i], frame);
-            s.tree.sample[i] =
-                (std::uint64_t(px.y) * std::uint64_t(options.width) + std::uint64_t(px.x)) * std::uint64_t(spp) +
-                std::uint64_t(index);
+        std::size_t i = 0;
+        for (const PixelXY& px : s.pixels) {
+            const std::uint64_t pixel = std::uint64_t(px.y) * std::uint64_t(options.width) + std::uint64_t(px.x);
+            for (int k = 0; k < spp; ++k, ++i) {
+                tracer.camera_sample(px.x, px.y, k, s.tree.rays[i], frame);
+                s.tree.sample[i] = pixel * std::uint64_t(spp) + std::uint64_t(k);
+            }
         }
         tracer.trace(n, s);
-        for (std::size_t i = 0; i < n; ++i) {
-            const PixelXY px = s.pixels[i / std::size_t(spp)];
-            if (spp == 1)
-                image.set(px.x, px.y, s.tree.color[i]);  // Whitted: exactly the ray's colour
-            else
-                film.add(px.x, px.y, s.tree.color[i]);
+        i = 0;
+        for (const PixelXY& px : s.pixels) {
+            if (spp == 1) {
+                image.set(px.x, px.y, s.tree.color[i++]);  // Whitted: exactly the ray's colour
+                continue;
+            }
+            for (int k = 0; k < spp; ++k) film->add(px.x, px.y, s.tree.color[i++]);
         }
         const std::uint64_t done = pixels_done.fetch_add(s.pixels.size(), std::memory_order_relaxed) + s.pixels.size();
         if (options.progress) options.progress(options.progress_context, done, pixels_total);
     });
-    if (spp > 1) image = film.resolve();
+    if (film) image = film->resolve();
     RenderStats stats;
     for (const auto& s : scratch)
         if (s) stats += s->stats;
