@@ -1,3 +1,4 @@
+#include <cmath>
 #include <cctype>
 #include <cerrno>
 #include <cstdlib>
@@ -48,6 +49,21 @@ long long ParsedArgs::integer(const std::string& name, long long fallback, long 
     const long long v = std::strtoll(s.c_str(), &end, 10);
     if (s.empty() || *end != '\0' || errno == ERANGE)
         throw UsageError("option " + name + " expects an integer, got '" + s + "'");
+    if (v < lo || v > hi)
+        throw UsageError("option " + name + " must be between " + std::to_string(lo) + " and " + std::to_string(hi) +
+                         ", got " + s);
+    return v;
+}
+
+double ParsedArgs::number(const std::string& name, double fallback, double lo, double hi) const {
+    const auto it = options_.find(name);
+    if (it == options_.end()) return fallback;
+    const std::string& s = it->second.at(0);
+    errno = 0;
+    char* end = nullptr;
+    const double v = std::strtod(s.c_str(), &end);
+    if (s.empty() || *end != '\0' || errno == ERANGE || !std::isfinite(v))
+        throw UsageError("option " + name + " expects a finite number, got '" + s + "'");
     if (v < lo || v > hi)
         throw UsageError("option " + name + " must be between " + std::to_string(lo) + " and " + std::to_string(hi) +
                          ", got " + s);

@@ -13,6 +13,7 @@
 #include "app/commands.h"
 #include "app/variant_options.h"
 #include "measure/cost_map.h"
+#include "render/path_tracer.h"
 #include "render/whitted.h"
 #include "scene/load.h"
 
@@ -95,7 +96,8 @@ int run_render(const Args& args) {
     spec.insert(spec.end(), {{"--output", "-o", 1}, {"--res", "", 2}, {"--depth", "", 1}, {"--threads", "", 1},
                              {"--aov", "", 1}, offset_option_spec(), {"--json", "", 0},
                              {"--quiet", "-q", 0}, {"--integrator", "", 1}, {"--spp", "", 1}, {"--sampler", "", 1},
-                             {"--seed", "", 1}, {"--light-samples", "", 1}, {"--filter", "", 1}});
+                             {"--seed", "", 1}, {"--light-samples", "", 1}, {"--filter", "", 1},
+                             {"--rr-depth", "", 1}, {"--exposure", "", 1}});
     const ParsedArgs p(args, spec, 1);
     if (p.help() || p.positional().empty()) {
         std::printf(
@@ -107,14 +109,18 @@ int run_render(const Args& args) {
             "  --threads T   worker threads (default: all cores)\n"
             "  --aov cost    instead of shading: the traversal cost (nodes + primitive tests) of each\n"
             "                pixel's camera ray as a viridis heat map with its scale below the picture\n"
-            "  --integrator whitted|distribution\n"
+            "  --integrator whitted|distribution|path\n"
             "                whitted (default): one ray per pixel centre, pinhole, mirrors, each area light\n"
-            "                one point; distribution: the samples below (Cook et al. 1984)\n"
-            "  --spp N       distribution: camera samples per pixel (default 16)\n"
+            "                one point; distribution: the samples below (Cook et al. 1984); path: path\n"
+            "                tracing with next-event estimation, radiance units (docs/renderer.md)\n"
+            "  --spp N       distribution, path: camera samples per pixel (default 16)\n"
+            "  --rr-depth D  path: bounces before Russian roulette may end a path (default 3);\n"
+            "                --depth caps the path (default 5)\n"
             "  --sampler regular|random|stratified|sobol   (default stratified)\n"
             "  --light-samples N  distribution: shadow rays per area light per sample (default 1)\n"
             "  --filter box|tent|gaussian  pixel filter (default box)\n"
             "  --seed S      random numbers of the samplers (default 1)\n"
+            "  --exposure E  multiply the image by E before writing it (default 1)\n"
             "  --json        print one JSON line (times, ray counts, Mrays/s) instead of the text report\n"
             "  --quiet, -q   print nothing on success\n"
             "  A progress line is shown on a terminal for renders that take more than a second.\n%s",
@@ -131,12 +137,19 @@ int run_render(const Args& args) {
     options.max_depth = int(p.integer("--depth", 5, 1, 64));
     options.offset = offset_policy_from(p);
     const std::string integrator = p.has("--integrator") ? p.text("--integrator") : "whitted";
-    if (integrator != "whitted" && integrator != "distribution")
-        throw UsageError("--integrator: expected whitted or distribution, got '" + integrator + "'");
-    options.distribution = integrator == "distribution";
+    if (integrator != "whitted" && integrator != "distribution" && integrator != "path")
+        throw UsageError("--integrator: expected whitted, distribution or path, got '" + integrator + "'");
+    options.distribution = integrator != "whitted";
     for (const char* flag : {"--spp", "--sampler", "--light-samples", "--filter", "--seed"})
         if (p.has(flag) && !options.distribution)
-            throw UsageError(std::string(flag) + " needs --integrator distribution");
+            throw UsageError(std::string(flag) + " needs --integrator distribution or path");
+    if (p.has("--rr-depth") && integrator != "path") throw UsageError("--rr-depth needs --integrator path");
+    if (p.has("--light-samples") && integrator == "path")
+        throw UsageError("--light-samples: the path integrator takes one light sample per bounce");
+    const float exposure = float(p.number("--exposure", 1.0, 0.0, 1e30));
+    PathOptions path;
+    path.rr_depth = int(p.integer("--rr-depth", 3, 0, 1 << 20));
+    path.max_depth = int(p.integer("--depth", 5, 1, 1 << 20));
     options.spp = int(p.integer("--spp", 16, 1, 1 << 16));
     options.light_samples = int(p.integer("--light-samples", 1, 1, 1 << 12));
     options.seed = std::uint64_t(p.integer("--seed", 1, 0, (1ll << 62)));
@@ -176,8 +189,11 @@ int run_render(const Args& args) {
     options.progress_context = &progress;
     start_loading_image_module(output);  // past the likely errors: the image module loads while tracing
     Image image;
-    const RenderStats stats = render_whitted(scene, *accel, options, image);
+    const RenderStats stats = integrator == "path" ? render_path(scene, *accel, options, path, image)
+                                                   : render_whitted(scene, *accel, options, image);
     progress.finish();
+    if (exposure != 1.0f)
+        for (float& v : image.rgb) v *= exposure;
     t0 = std::chrono::steady_clock::now();
     write_image(output, image);
     const double write_ms = ms_since(t0);
@@ -191,9 +207,10 @@ int run_render(const Args& args) {
         j["width"] = options.width;
         j["height"] = options.height;
         j["spp"] = options.distribution ? options.spp : 1;
+        if (integrator == "path") j["rr_depth"] = path.rr_depth;
         if (options.distribution) {
             j["sampler"] = sampler_name(options.sampler);
-            j["light_samples"] = options.light_samples;
+            if (integrator == "distribution") j["light_samples"] = options.light_samples;
             j["filter"] = pixel_filter_name(options.filter);
             j["seed"] = options.seed;
         }
@@ -211,7 +228,8 @@ int run_render(const Args& args) {
                      {"eye_hits", stats.eye_hits},
                      {"shadow", stats.shadow_rays},
                      {"reflect", stats.reflect_rays},
-                     {"refract", stats.refract_rays}};
+                     {"refract", stats.refract_rays},
+                     {"diffuse", stats.diffuse_rays}};
         j["mrays_per_s"] = mrays;
         j["output"] = std::filesystem::absolute(output).string();
         std::printf("%s\n", j.dump().c_str());
@@ -231,15 +249,20 @@ int run_render(const Args& args) {
                 "%s: %.1f ms, %.2f Mrays/s\n",
                 options.width, options.height, options.max_depth, limit.threads(), options.packet,
                 options.secondary_packet, offset_policy_name(options.offset),
-                options.distribution ? "Distribution" : "Whitted", stats.render_ms, mrays);
+                integrator == "path" ? "Path" : options.distribution ? "Distribution" : "Whitted", stats.render_ms,
+                mrays);
     if (options.distribution)
-        std::printf("  sampling   %d samples per pixel (%s, %s filter, seed %llu), %d per area light\n", options.spp,
+        std::printf("  sampling   %d samples per pixel (%s, %s filter, seed %llu), %s\n", options.spp,
                     sampler_name(options.sampler), pixel_filter_name(options.filter),
-                    (unsigned long long)options.seed, options.light_samples);
-    std::printf("  rays       eye %llu (%llu hit), reflect %llu, refract %llu, shadow %llu\n",
+                    (unsigned long long)options.seed,
+                    integrator == "path" ? ("Russian roulette after " + std::to_string(path.rr_depth) + " bounces").c_str()
+                                         : (std::to_string(options.light_samples) + " per area light").c_str());
+    std::printf("  rays       eye %llu (%llu hit), reflect %llu, refract %llu, shadow %llu",
                 (unsigned long long)stats.eye_rays, (unsigned long long)stats.eye_hits,
                 (unsigned long long)stats.reflect_rays, (unsigned long long)stats.refract_rays,
                 (unsigned long long)stats.shadow_rays);
+    if (stats.diffuse_rays) std::printf(", diffuse %llu", (unsigned long long)stats.diffuse_rays);
+    std::printf("\n");
     std::printf("  image      %s (written in %.1f ms)\n", std::filesystem::absolute(output).string().c_str(), write_ms);
     return 0;
 }

@@ -34,6 +34,8 @@ public:
     std::string text(const std::string& name, const std::string& fallback = "") const;
     /// Integer value `index` of option `name`, which must lie in [lo, hi].
     long long integer(const std::string& name, long long fallback, long long lo, long long hi, int index = 0) const;
+    /// A finite number in [lo, hi], or `fallback` when the option is absent.
+    double number(const std::string& name, double fallback, double lo, double hi) const;
 
 private:
     std::vector<std::string> positional_;

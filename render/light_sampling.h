@@ -21,4 +21,8 @@ struct LightSample {
 /// itself.
 LightSample sample_area_light(const AreaLight& light, const Vec3f& seen_from, Sample2 u);
 
+/// The density by area with which sample_area_light(light, seen_from, .)
+/// picks a point of the region it samples (for multiple importance sampling).
+float area_light_pdf(const AreaLight& light, const Vec3f& seen_from);
+
 }  // namespace raypack

@@ -4,6 +4,7 @@
 // image position passes through the point that the pinhole ray reaches on
 // the plane in focus, and starts from a point of the aperture disc.
 #include "render/camera_rays.h"
+#include "render/film.h"
 #include "render/sampler.h"
 #include "render/sampling.h"
 
@@ -24,6 +25,16 @@ inline Rayf thin_lens_ray(const CameraFrame& f, float px, float py, Sample2 lens
     ray.org = ray.org + offset;
     ray.dir = ray.dir - offset / focus;
     return ray;
+}
+
+/// Camera sample `index` of pixel (x, y) (number `pixel`) for the sampled
+/// integrators: its position drawn from the pixel filter (sampler dimension
+/// 0), its lens point from dimension 1.
+inline void sampled_camera_ray(const CameraFrame& f, const Camera& camera, const Sampler& sampler, PixelFilter filter,
+                               std::uint64_t pixel, int x, int y, int index, Rayf& out) {
+    const Sample2 off = filter_offset(filter, sampler.get(pixel, index, 0));
+    out = thin_lens_ray(f, float(x) + 0.5f + off.x, float(y) + 0.5f + off.y, sampler.get(pixel, index, 1),
+                        camera.lens_radius, camera.focus_distance);
 }
 
 }  // namespace raypack

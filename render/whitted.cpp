@@ -23,6 +23,7 @@ RenderStats& RenderStats::operator+=(const RenderStats& o) {
     reflect_rays += o.reflect_rays;
     refract_rays += o.refract_rays;
     shadow_rays += o.shadow_rays;
+    diffuse_rays += o.diffuse_rays;
     return *this;
 }
 
@@ -136,9 +137,7 @@ public:
             return;
         }
         const std::uint64_t pixel = std::uint64_t(y) * std::uint64_t(options_.width) + std::uint64_t(x);
-        const Sample2 off = filter_offset(options_.filter, samples_.get(pixel, index, 0));
-        ray = thin_lens_ray(frame, float(x) + 0.5f + off.x, float(y) + 0.5f + off.y, samples_.get(pixel, index, 1),
-                            scene_.camera.lens_radius, scene_.camera.focus_distance);
+        sampled_camera_ray(frame, scene_.camera, samples_, options_.filter, pixel, x, y, index, ray);
     }
 
     /// Traces the whole ray tree of the eye rays s.tree.rays[0 .. eye) (set

@@ -175,8 +175,11 @@ private:
 
     /// Objects before any "f" get a default material rather than an error.
     std::uint32_t material() {
-        if (scene_.materials.empty()) scene_.materials.push_back(Material{});
-        return std::uint32_t(scene_.materials.size() - 1);
+        if (current_material_ < 0) {
+            scene_.materials.push_back(Material{});
+            current_material_ = std::int32_t(scene_.materials.size() - 1);
+        }
+        return std::uint32_t(current_material_);
     }
 
     // The spec wants "v" before any object; nothing here depends on that, so
@@ -320,6 +323,7 @@ private:
         m.ior = number("index of refraction");
         m.gloss = gloss_;
         scene_.materials.push_back(m);
+        current_material_ = std::int32_t(scene_.materials.size() - 1);
     }
 
     void sphere() {
@@ -378,6 +382,8 @@ private:
     int camera_line_ = 0;  ///< line of the "v" block, 0 while none
     int lens_line_ = 0;    ///< line of the "lens" line, 0 while none
     float gloss_ = 0;      ///< the last "gloss" value, for the "f" lines after it
+    /// The last "f" (lights' own surfaces get copies of it appended after it), -1 before any.
+    std::int32_t current_material_ = -1;
     std::vector<Vec3f> verts_, normals_;  ///< reused between polygons
 };
 

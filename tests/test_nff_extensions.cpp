@@ -32,7 +32,7 @@ protected:
 };
 
 TEST_F(NffExtensions, ParallelogramLightIsTwoTrianglesFacingItsEmittingSide) {
-    const Scene s = load(std::string(kView) + "f 1 0 0 1 0 0 0 1\nla 0 2 0  1 0 0  0 0 1  1 0.5 0.25\n");
+    const Scene s = load(std::string(kView) + "f 1 0 0 1 0 0 0 1\nla 0 2 0  1 0 0  0 0 1  1 0.5 0.25\ns 0 0 -5 1\n");
     ASSERT_EQ(s.area_lights.size(), 1u);
     const auto& l = s.area_lights[0];
     EXPECT_EQ(l.shape, AreaLightShape::Parallelogram);
@@ -44,6 +44,10 @@ TEST_F(NffExtensions, ParallelogramLightIsTwoTrianglesFacingItsEmittingSide) {
     EXPECT_FLOAT_EQ(l.area(), 1.0f);
     ASSERT_EQ(l.prim_count, 2u);
     ASSERT_EQ(s.triangles.size(), 2u);
+    // Objects after the light have the fill's material, not the light's surface.
+    ASSERT_EQ(s.spheres.size(), 1u);
+    EXPECT_EQ(s.materials[s.prim_material[2]].area_light, -1);
+    EXPECT_EQ(s.materials[s.prim_material[2]].color, (Vec3f{1, 0, 0}));
     // e x f = (1,0,0) x (0,0,1) = (0,-1,0): both triangles face down.
     for (std::uint32_t p = l.first_prim; p < l.first_prim + 2; ++p) {
         EXPECT_EQ(s.prims[p].kind, PrimKind::Triangle);

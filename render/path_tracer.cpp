@@ -1,0 +1,353 @@
+#include "render/path_tracer.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <numbers>
+#include <vector>
+
+#include "render/camera_rays.h"
+#include "render/film.h"
+#include "render/light_sampling.h"
+#include "render/ray_offset.h"
+#include "render/sampler.h"
+#include "render/sampling.h"
+#include "render/surface.h"
+#include "render/thin_lens.h"
+#include "render/tiles.h"
+
+namespace raypack {
+namespace {
+
+constexpr float kInvPi = std::numbers::inv_pi_v<float>;
+
+float max_component(const Vec3f& v) { return std::max({v.x, v.y, v.z}); }
+
+/// The live paths of one tile: their next ray, what they carry, and where
+/// their radiance goes.
+struct Paths {
+    std::vector<Rayf> rays;
+    std::vector<Hitf> hits;
+    std::vector<Vec3f> throughput;
+    std::vector<std::uint32_t> sample;  ///< index into the tile's samples (radiance, sampler key)
+    std::vector<std::uint8_t> count_emission;  ///< camera ray, or after a specular bounce
+    /// After a diffuse bounce: its direction's density (solid angle) and
+    /// origin, for the MIS weight of emission the ray finds.
+    std::vector<float> bounce_pdf;
+    std::vector<Vec3f> bounce_origin;
+
+    void clear() {
+        rays.clear();
+        hits.clear();
+        throughput.clear();
+        sample.clear();
+        count_emission.clear();
+        bounce_pdf.clear();
+        bounce_origin.clear();
+    }
+    void add(const Rayf& r, const Vec3f& beta, std::uint32_t s, bool emission, float pdf = 0) {
+        bounce_pdf.push_back(pdf);
+        bounce_origin.push_back(r.org);
+        rays.push_back(r);
+        hits.emplace_back();
+        throughput.push_back(beta);
+        sample.push_back(s);
+        count_emission.push_back(emission);
+    }
+};
+
+struct Shadows {
+    std::vector<Rayf> rays;
+    std::vector<std::uint32_t> sample;
+    std::vector<Vec3f> contribution;
+    std::vector<std::uint8_t> occluded;
+    void clear() {
+        rays.clear();
+        sample.clear();
+        contribution.clear();
+    }
+};
+
+struct Scratch {
+    std::vector<PixelXY> pixels;
+    std::vector<std::uint64_t> keys;  ///< pixel * spp + index, per sample of the tile
+    std::vector<Vec3f> radiance;      ///< per sample of the tile
+    Paths paths, next;
+    Shadows shadows;
+    RenderStats stats;
+};
+
+class PathTracer {
+public:
+    PathTracer(const Scene& scene, const Accel& accel, const WhittedOptions& options, const PathOptions& path)
+        : scene_(scene),
+          accel_(accel),
+          options_(options),
+          path_(path),
+          offset_(options.offset, scene),
+          samples_(options.sampler, options.spp, options.seed) {}
+
+    const Sampler& samples() const { return samples_; }
+
+    /// Traces the paths whose camera rays are s.paths (one per sample of
+    /// the tile), adding their radiance to s.radiance.
+    void trace(Scratch& s) const {
+        s.stats.eye_rays += s.paths.rays.size();
+        for (int depth = 1; !s.paths.rays.empty(); ++depth) {
+            Paths& p = s.paths;
+            accel_.intersect_packets(depth == 1 ? options_.packet : options_.secondary_packet, p.rays, p.hits);
+            if (depth == 1)
+                for (const Hitf& h : p.hits) s.stats.eye_hits += h.found();
+            s.next.clear();
+            s.shadows.clear();
+            for (std::size_t i = 0; i < p.rays.size(); ++i) bounce(i, depth, s);
+            trace_shadows(s);
+            std::swap(s.paths, s.next);
+        }
+    }
+
+private:
+    const Scene& scene_;
+    const Accel& accel_;
+    const WhittedOptions& options_;
+    const PathOptions& path_;
+    RayOffset offset_;
+    Sampler samples_;
+
+    /// The unit-square point of dimension `dim` of sample `key`: each bounce
+    /// uses its own dimensions (light choice, light point, lobe, roulette).
+    Sample2 get(std::uint64_t key, int dim) const {
+        const auto spp = std::uint64_t(samples_.spp());
+        return samples_.get(key / spp, int(key % spp), dim);
+    }
+
+    void bounce(std::size_t i, int depth, Scratch& s) const {
+        const Paths& p = s.paths;
+        const Rayf ray = p.rays[i];
+        const Hitf hit = p.hits[i];
+        const std::uint32_t si = p.sample[i];
+        const std::uint64_t key = s.keys[si];
+        const Vec3f beta = p.throughput[i];
+        Vec3f& L = s.radiance[si];
+        if (!hit.found()) {
+            L += beta * scene_.background;
+            return;
+        }
+        const Surface surf = surface_at(scene_, ray, hit);
+        const Material& m = scene_.materials[surf.material];
+        const Vec3f wo = -normalize(ray.dir);
+        const bool front = dot(wo, surf.geometric_normal) > 0;
+        const Vec3f ng = front ? surf.geometric_normal : -surf.geometric_normal;
+        Vec3f ns = front ? surf.shading_normal : -surf.shading_normal;
+        if (dot(ns, ng) < 0) ns = ng;
+        if (m.area_light >= 0) {
+            if (p.count_emission[i]) {
+                L += beta * emitted(m.area_light, surf.geometric_normal, wo);
+            } else if (p.bounce_pdf[i] > 0) {
+                // Found by a diffuse bounce that next-event estimation could
+                // also have sampled: weight by the power heuristic (Veach 1997).
+                const Vec3f d = surf.point - p.bounce_origin[i];
+                const float cos_l = std::fabs(dot(surf.geometric_normal, normalize(d)));
+                const float pdf_light =
+                    light_choice_pdf() * area_light_pdf(scene_.area_lights[std::size_t(m.area_light)],
+                                                        p.bounce_origin[i]) * dot(d, d) / std::max(cos_l, 1e-12f);
+                L += beta * emitted(m.area_light, surf.geometric_normal, wo) *
+                     power_heuristic(p.bounce_pdf[i], pdf_light);
+            }
+        }
+        if (depth >= path_.max_depth) return;
+
+        const Vec3f hp = offset_.hit_point(scene_, ray, hit, surf.point);
+        const Vec3f above = offset_.offset(hp, ng);
+        // Dimensions of this bounce: part choice and roulette, light choice,
+        // point on the light, direction of the bounce.
+        const int dim = 2 + 4 * (depth - 1);
+        // Choose one of the material's three parts in proportion to its weight.
+        const Vec3f albedo = m.color * m.kd;
+        const float wd = std::max(0.0f, max_component(albedo)), ws = std::max(0.0f, m.ks),
+                    wt = std::max(0.0f, m.transmittance), total = wd + ws + wt;
+        if (!(total > 0)) return;
+        const Sample2 choice = get(key, dim);
+        const float pick = choice.x * total;
+        Vec3f dir;
+        Vec3f weight;
+        bool specular = true;
+        float bounce_pdf = 0;
+        Vec3f origin = above;
+        if (pick < wd) {
+            // Lambertian: next-event estimation, then a cosine-weighted bounce.
+            const Vec3f f = albedo * kInvPi;
+            direct_light(si, above, ns, ng, beta * (total / wd), f, key, dim + 1, s);
+            const Sample2 u = get(key, dim + 3);
+            const Vec3f local = cosine_hemisphere(u.x, u.y);
+            dir = OrthonormalBasis<float>(ns).to_world(local);
+            bounce_pdf = local.z * kInvPi;
+            weight = albedo * (total / wd);  // f cos / pdf = albedo
+            specular = false;
+            ++s.stats.diffuse_rays;
+        } else if (pick < wd + ws) {
+            const Vec3f mirror = ns * (2.0f * dot(wo, ns)) - wo;
+            dir = mirror;
+            if (m.gloss > 0) {
+                // Normalised Phong lobe about the mirror direction, sampled
+                // exactly: the weight is 1 wherever the lobe is above the surface.
+                const Sample2 u = get(key, dim + 3);
+                dir = OrthonormalBasis<float>(normalize(mirror)).to_world(phong_lobe(m.gloss, u.x, u.y));
+                if (dot(dir, ng) <= 0) return;  // absorbed under the surface
+            }
+            weight = Vec3f{1, 1, 1} * (total / ws) * m.ks;
+            ++s.stats.reflect_rays;
+        } else {
+            // Dielectric interface without Fresnel (NFF's T is the weight).
+            const float eta = front ? 1.0f / m.ior : m.ior;
+            const float cos_i = dot(wo, ns);
+            const float k = 1.0f - eta * eta * (1.0f - cos_i * cos_i);
+            weight = Vec3f{1, 1, 1} * (total / wt) * m.transmittance;
+            if (k >= 0) {
+                dir = -wo * eta + ns * (eta * cos_i - std::sqrt(k));
+                origin = offset_.offset(hp, -ng);
+                ++s.stats.refract_rays;
+            } else {
+                dir = ns * (2.0f * dot(wo, ns)) - wo;  // total internal reflection
+                ++s.stats.reflect_rays;
+            }
+        }
+        Vec3f next_beta = beta * weight;
+        // Russian roulette (Arvo and Kirk 1990): survive with probability q,
+        // divide by it, so the estimate stays unbiased.
+        if (depth > path_.rr_depth) {
+            const float q = std::min(1.0f, max_component(next_beta));
+            if (!(choice.y < q)) return;
+            next_beta = next_beta / q;
+        }
+        if (!(max_component(next_beta) > 0)) return;
+        Rayf next_ray;
+        spawn_ray(origin, dir, offset_, next_ray);
+        s.next.add(next_ray, next_beta, si, specular, bounce_pdf);
+    }
+
+    /// Radiance an area light's surface emits toward `wo`: its colour on
+    /// the emitting side of a parallelogram, everywhere on a sphere's
+    /// outside.
+    Vec3f emitted(std::int32_t light, const Vec3f& geometric_normal, const Vec3f& wo) const {
+        const AreaLight& l = scene_.area_lights[std::size_t(light)];
+        if (l.shape == AreaLightShape::Parallelogram && dot(cross(l.edge1, l.edge2), wo) <= 0) return {};
+        if (l.shape == AreaLightShape::Sphere && dot(geometric_normal, wo) <= 0) return {};
+        return l.color;
+    }
+
+    /// Probability of choosing a given light in direct_light.
+    float light_choice_pdf() const {
+        return 1.0f / float(scene_.lights.size() + scene_.distant_lights.size() + scene_.area_lights.size());
+    }
+
+    static float power_heuristic(float f, float g) { return f * f / (f * f + g * g); }
+
+    /// One shadow ray to one light chosen uniformly among all of them
+    /// (point, distant, area), weighted by their number.
+    void direct_light(std::uint32_t si, const Vec3f& above, const Vec3f& ns, const Vec3f& ng, const Vec3f& beta,
+                      const Vec3f& f, std::uint64_t key, int dim, Scratch& s) const {
+        const std::size_t n_point = scene_.lights.size(), n_distant = scene_.distant_lights.size();
+        const std::size_t n = n_point + n_distant + scene_.area_lights.size();
+        if (n == 0) return;
+        const Sample2 u = get(key, dim);
+        const std::size_t pick = std::min(n - 1, std::size_t(u.x * float(n)));
+        const float choose = float(n);
+        Rayf r;
+        Vec3f contribution;
+        if (pick < n_point) {
+            const PointLight& l = scene_.lights[pick];
+            const Vec3f d = l.position - above;
+            const float dist2 = dot(d, d);
+            const Vec3f wi = d / std::sqrt(dist2);
+            const float cos_s = dot(ns, wi);
+            if (cos_s <= 0 || dot(ng, wi) <= 0) return;
+            contribution = beta * f * l.color * (cos_s / dist2 * choose);
+            spawn_ray_to(above, l.position, offset_, r);
+        } else if (pick < n_point + n_distant) {
+            const DistantLight& l = scene_.distant_lights[pick - n_point];
+            const Vec3f wi = -l.direction;
+            const float cos_s = dot(ns, wi);
+            if (cos_s <= 0 || dot(ng, wi) <= 0) return;
+            contribution = beta * f * l.color * (cos_s * choose);
+            spawn_ray(above, wi, offset_, r);
+        } else {
+            const AreaLight& l = scene_.area_lights[pick - n_point - n_distant];
+            const Sample2 v = get(key, dim + 1);
+            const LightSample ls = sample_area_light(l, above, v);
+            const Vec3f d = ls.point - above;
+            const float dist2 = dot(d, d);
+            if (!(dist2 > 0)) return;
+            const Vec3f wi = d / std::sqrt(dist2);
+            const float cos_s = dot(ns, wi), cos_l = -dot(ls.normal, wi);
+            if (cos_s <= 0 || dot(ng, wi) <= 0 || cos_l <= 0) return;
+            // Multiple importance sampling with the diffuse bounce (cos / pi).
+            const float pdf_light = ls.pdf_area * dist2 / cos_l / choose;
+            const float w = power_heuristic(pdf_light, cos_s * kInvPi);
+            contribution = beta * f * l.color * (cos_s * cos_l / (dist2 * ls.pdf_area) * choose * w);
+            spawn_ray_to(above, ls.point, offset_, r);
+        }
+        ++s.stats.shadow_rays;
+        s.shadows.rays.push_back(r);
+        s.shadows.sample.push_back(si);
+        s.shadows.contribution.push_back(contribution);
+    }
+
+    void trace_shadows(Scratch& s) const {
+        Shadows& b = s.shadows;
+        if (b.rays.empty()) return;
+        b.occluded.resize(b.rays.size());
+        accel_.occluded_packets(options_.secondary_packet, b.rays, b.occluded);
+        for (std::size_t k = 0; k < b.rays.size(); ++k)
+            if (!b.occluded[k]) s.radiance[b.sample[k]] += b.contribution[k];
+    }
+};
+
+}  // namespace
+
+RenderStats render_path(const Scene& scene, const Accel& accel, const WhittedOptions& options,
+                        const PathOptions& path, Image& image) {
+    const auto start = std::chrono::steady_clock::now();
+    const CameraFrame frame = make_camera_frame(scene.camera, options.width, options.height);
+    const PathTracer tracer(scene, accel, options, path);
+    const int spp = options.spp;
+    const TileGrid grid{options.width, options.height, options.tile_size};
+    std::vector<std::unique_ptr<Scratch>> scratch(static_cast<std::size_t>(worker_slots()));
+    std::atomic<std::uint64_t> pixels_done{0};
+    const std::uint64_t pixels_total = std::uint64_t(options.width) * std::uint64_t(options.height);
+    Film film(options.width, options.height);
+    for_each_tile(grid, [&](int tile, int slot) {
+        auto& mine = scratch[std::size_t(slot)];
+        if (!mine) mine = std::make_unique<Scratch>();
+        Scratch& s = *mine;
+        grid.pixels(tile, s.pixels);
+        s.paths.clear();
+        s.keys.clear();
+        s.radiance.assign(s.pixels.size() * std::size_t(spp), Vec3f{});
+        for (const PixelXY& px : s.pixels) {
+            const std::uint64_t pixel = std::uint64_t(px.y) * std::uint64_t(options.width) + std::uint64_t(px.x);
+            for (int k = 0; k < spp; ++k) {
+                Rayf r;
+                sampled_camera_ray(frame, scene.camera, tracer.samples(), options.filter, pixel, px.x, px.y, k, r);
+                s.paths.add(r, {1, 1, 1}, std::uint32_t(s.keys.size()), true);
+                s.keys.push_back(pixel * std::uint64_t(spp) + std::uint64_t(k));
+            }
+        }
+        tracer.trace(s);
+        std::size_t i = 0;
+        for (const PixelXY& px : s.pixels)
+            for (int k = 0; k < spp; ++k) film.add(px.x, px.y, s.radiance[i++]);
+        const std::uint64_t done = pixels_done.fetch_add(s.pixels.size(), std::memory_order_relaxed) + s.pixels.size();
+        if (options.progress) options.progress(options.progress_context, done, pixels_total);
+    });
+    image = film.resolve();
+    RenderStats stats;
+    for (const auto& s : scratch)
+        if (s) stats += s->stats;
+    stats.render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return stats;
+}
+
+}  // namespace raypack

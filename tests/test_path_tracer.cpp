@@ -1,0 +1,102 @@
+// The path tracer (render/path_tracer.h) against the furnace: inside a
+// closed diffuse enclosure of albedo a that emits radiance E everywhere,
+// every pixel converges to E (1 + a + a^2 + ...) = E / (1 - a); Russian
+// roulette leaves the mean unchanged; images do not depend on the thread count.
+#include <gtest/gtest.h>
+
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <sstream>
+#include <string>
+
+#include "accel/accel.h"
+#include "render/path_tracer.h"
+#include "scene/load.h"
+
+namespace raypack {
+namespace {
+
+/// The unit cube, each face a parallelogram light facing inward, of
+/// albedo `a`; the camera at its centre.
+Scene furnace(float a) {
+    std::ostringstream nff;
+    nff << "v\nfrom 0.5 0.5 0.5\nat 0.5 0.5 0\nup 0 1 0\nangle 100\nhither 0\nresolution 8 8\n";
+    nff << "f 1 1 1 " << a << " 0 0 0 1\n";
+    nff << "la 0 0 0  1 0 0  0 1 0\nla 0 0 1  0 1 0  1 0 0\n"   // z = 0, z = 1
+        << "la 0 0 0  0 1 0  0 0 1\nla 1 0 0  0 0 1  0 1 0\n"   // x = 0, x = 1
+        << "la 0 0 0  0 0 1  1 0 0\nla 0 1 0  1 0 0  0 0 1\n";  // y = 0, y = 1
+    std::istringstream in(nff.str());
+    return load_nff(in, "furnace");
+}
+
+struct Estimate {
+    double mean, standard_error;
+};
+
+Estimate render_furnace(const Scene& s, int rr_depth, int max_depth, int spp, std::uint64_t seed) {
+    const auto accel = build_accel(s, AccelConfig{});
+    WhittedOptions o;
+    o.width = o.height = 8;
+    o.distribution = true;
+    o.spp = spp;
+    o.seed = seed;
+    o.sampler = SamplerKind::Random;
+    PathOptions path;
+    path.rr_depth = rr_depth;
+    path.max_depth = max_depth;
+    Image image;
+    render_path(s, *accel, o, path, image);
+    // Red channel only: the grey furnace's channels are the same numbers.
+    double sum = 0, sum_sq = 0;
+    const std::size_t n = image.rgb.size() / 3;
+    for (std::size_t i = 0; i < n; ++i) {
+        const double v = image.rgb[3 * i];
+        sum += v;
+        sum_sq += v * v;
+    }
+    const double mean = sum / double(n), var = sum_sq / double(n) - mean * mean;
+    return {mean, std::sqrt(std::max(0.0, var) / double(n))};
+}
+
+TEST(PathTracer, FurnaceConvergesToEmissionOverOneMinusAlbedo) {
+    for (float a : {0.5f, 0.8f}) {
+        const Scene s = furnace(a);
+        const double expected = 1.0 / (1.0 - a);  // E = 1 (the lights' default colour)
+        // Without roulette: 64 vertices leave a^64 of the sum out.
+        const Estimate fixed = render_furnace(s, 1000, 64, 512, 1);
+        EXPECT_NEAR(fixed.mean, expected, 0.01 * expected) << "albedo " << a;
+        // With roulette from the first bounce.
+        const Estimate rr = render_furnace(s, 0, 1000, 2048, 2);
+        EXPECT_NEAR(rr.mean, expected, 0.01 * expected) << "albedo " << a << " se " << rr.standard_error;
+        EXPECT_LT(std::fabs(rr.mean - fixed.mean), 3 * std::hypot(rr.standard_error, fixed.standard_error))
+            << "albedo " << a;
+        // A cap of D vertices sums the first D terms: (1 - a^D) / (1 - a).
+        const Estimate capped = render_furnace(s, 1000, 3, 512, 3);
+        const double three = (1 - std::pow(a, 3)) / (1 - a);
+        EXPECT_NEAR(capped.mean, three, 0.01 * three) << "albedo " << a;
+    }
+}
+
+TEST(PathTracer, SameImageForAnyThreadCount) {
+    const Scene s = load_scene("gen:cornell:2");
+    const auto accel = build_accel(s, AccelConfig{});
+    WhittedOptions o;
+    o.width = o.height = 40;
+    o.distribution = true;
+    o.spp = 4;
+    o.sampler = SamplerKind::Sobol;
+    Image one, two;
+    {
+        const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+        render_path(s, *accel, o, PathOptions{}, one);
+    }
+    {
+        const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+        render_path(s, *accel, o, PathOptions{}, two);
+    }
+    EXPECT_EQ(one.rgb, two.rgb);
+}
+
+}  // namespace
+}  // namespace raypack
