@@ -15,15 +15,25 @@ std::uint64_t mix(std::uint64_t h) {
     return h ^ (h >> 31);
 }
 
-std::uint64_t hash_keys(std::uint64_t seed, std::uint64_t pixel, std::uint64_t dimension, std::uint64_t purpose) {
-    std::uint64_t h = mix(seed + 0x9E3779B97F4A7C15ull);
-    h = mix(h ^ (pixel + 0x9E3779B97F4A7C15ull * 2));
-    h = mix(h ^ (dimension * 0x100000001B3ull + purpose + 1));
-    return h;
+/// `seed_hash` is mix(seed + golden ratio), computed once per sampler.
+std::uint64_t hash_keys(std::uint64_t seed_hash, std::uint64_t pixel, std::uint64_t dimension, std::uint64_t purpose) {
+    const std::uint64_t h = mix(seed_hash ^ (pixel + 0x9E3779B97F4A7C15ull * 2));
+    return mix(h ^ (dimension * 0x100000001B3ull + purpose + 1));
 }
 
 /// [0, 1) from the top 24 bits, so that the float never rounds up to 1.
 float unit_float(std::uint32_t bits) { return float(bits >> 8) * 0x1.0p-24f; }
+
+/// A point of stratum c of n along one axis, from 32 random bits: in double,
+/// then moved to the float nearest it inside [c / n, (c + 1) / n) (a float
+/// sum c + jitter would round up into the next stratum).
+float in_stratum(std::uint32_t c, std::uint32_t n, double inv_n, std::uint32_t bits) {
+    float f = float((double(c) + double(bits) * 0x1.0p-32) * inv_n);
+    // The product f n is exact in double (24 + 32 bits): compare strata exactly.
+    while (double(f) * double(n) >= double(c + 1)) f = std::nextafter(f, 0.0f);
+    while (double(f) * double(n) < double(c)) f = std::nextafter(f, 1.0f);
+    return f;
+}
 
 /// A pseudo-random permutation of [0, n) (Kensler, "Correlated
 /// Multi-Jittered Sampling", Pixar Technical Memo 13-01, 2013): an
@@ -122,7 +132,10 @@ StrataGrid strata_grid(int spp) {
 }
 
 Sampler::Sampler(SamplerKind kind, int spp, std::uint64_t seed)
-    : kind_(kind), spp_(spp), seed_(seed), grid_(strata_grid(spp)) {}
+    : kind_(kind), spp_(spp), seed_(seed), seed_hash_(mix(seed + 0x9E3779B97F4A7C15ull)),
+      grid_(strata_grid(spp)),
+      inv_nx_(1.0 / grid_.nx),
+      inv_ny_(1.0 / grid_.ny) {}
 
 Sample2 Sampler::get(std::uint64_t pixel, int index, int dimension) const {
     const auto n = std::uint32_t(spp_), i = std::uint32_t(index);
@@ -136,27 +149,26 @@ Sample2 Sampler::get(std::uint64_t pixel, int index, int dimension) const {
                     (float(cell / std::uint32_t(grid_.nx)) + 0.5f) / float(grid_.ny)};
         }
         case SamplerKind::Random: {
-            const std::uint64_t h = hash_keys(seed_, pixel, std::uint64_t(dimension), 1 + std::uint64_t(i) * 4);
+            const std::uint64_t h = hash_keys(seed_hash_, pixel, std::uint64_t(dimension), 1 + std::uint64_t(i) * 4);
             return {unit_float(std::uint32_t(h)), unit_float(std::uint32_t(h >> 32))};
         }
         case SamplerKind::Stratified: {
             // Cells shuffled per pixel and dimension (pbrt's stratified
             // sampler shuffles too), so that dimensions are not correlated.
-            const std::uint64_t key = hash_keys(seed_, pixel, std::uint64_t(dimension), 0);
+            const std::uint64_t key = hash_keys(seed_hash_, pixel, std::uint64_t(dimension), 0);
             const std::uint32_t cell = permute(i, n, std::uint32_t(key));
-            const std::uint64_t jitter = hash_keys(seed_, pixel, std::uint64_t(dimension), 2 + std::uint64_t(i) * 4);
-            const float jx = unit_float(std::uint32_t(jitter)), jy = unit_float(std::uint32_t(jitter >> 32));
-            // The sum can round up to the next cell's edge, never to 1.
-            const float x = (float(cell % std::uint32_t(grid_.nx)) + jx) / float(grid_.nx);
-            const float y = (float(cell / std::uint32_t(grid_.nx)) + jy) / float(grid_.ny);
-            return {x < 1.0f ? x : 0x1.fffffep-1f, y < 1.0f ? y : 0x1.fffffep-1f};
+            // The jitter of sample i: one more mix of the (pixel, dimension) key.
+            const std::uint64_t jitter = mix(key + 0x9E3779B97F4A7C15ull * (std::uint64_t(i) + 1));
+            const auto nx = std::uint32_t(grid_.nx), ny = std::uint32_t(grid_.ny);
+            const std::uint32_t cy = cell / nx, cx = cell - cy * nx;
+            return {in_stratum(cx, nx, inv_nx_, std::uint32_t(jitter)), in_stratum(cy, ny, inv_ny_, std::uint32_t(jitter >> 32))};
         }
         case SamplerKind::Sobol: {
             // Burley (2020): shuffle the index by an Owen scramble (which keeps
             // it inside one aligned block of 2^m points, a (0, m, 2)-net), then
             // Owen-scramble each coordinate; seeds per pixel and dimension.
-            const std::uint64_t k1 = hash_keys(seed_, pixel, std::uint64_t(dimension), 0);
-            const std::uint64_t k2 = hash_keys(seed_, pixel, std::uint64_t(dimension), 3);
+            const std::uint64_t k1 = hash_keys(seed_hash_, pixel, std::uint64_t(dimension), 0);
+            const std::uint64_t k2 = mix(k1 + 0x9E3779B97F4A7C15ull);
             const std::uint32_t shuffled = owen_scramble(i, std::uint32_t(k1));
             return {unit_float(owen_scramble(sobol0(shuffled), std::uint32_t(k1 >> 32))),
                     unit_float(owen_scramble(sobol1(shuffled), std::uint32_t(k2)))};

@@ -48,7 +48,9 @@ private:
     SamplerKind kind_;
     int spp_;
     std::uint64_t seed_;
+    std::uint64_t seed_hash_;  ///< the seed's hash, computed once
     StrataGrid grid_;
+    double inv_nx_, inv_ny_;
 };
 
 }  // namespace raypack

@@ -109,7 +109,7 @@ TEST(Sampler, StratifiedPutsOnePointInEachCellOfEveryDimension) {
                 std::vector<int> count(std::size_t(spp), 0);
                 for (int i = 0; i < spp; ++i) {
                     const Sample2 u = s.get(pixel, i, dim);
-                    ++count[std::size_t(int(u.y * float(g.ny)) * g.nx + int(u.x * float(g.nx)))];
+                    ++count[std::size_t(int(double(u.y) * g.ny) * g.nx + int(double(u.x) * g.nx))];
                 }
                 for (int c : count) ASSERT_EQ(c, 1) << "spp " << spp << " pixel " << pixel << " dim " << dim;
             }
