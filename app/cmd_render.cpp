@@ -16,6 +16,7 @@
 #include "render/path_tracer.h"
 #include "render/whitted.h"
 #include "scene/load.h"
+#include "scene/memory_budget.h"
 
 namespace raypack::app {
 namespace {
@@ -175,6 +176,9 @@ int run_render(const Args& args) {
     options.height = int(p.integer("--res", scene.camera.height, 1, 65536, 1));
     if (std::uint64_t(options.width) * std::uint64_t(options.height) > (1ull << 28))
         throw UsageError("--res: image of more than 2^28 pixels");
+    // The image, and the film of a sampled render: 12 bytes a pixel each, plus the counts.
+    require_memory(std::uint64_t(options.width) * std::uint64_t(options.height) * (options.distribution ? 28 : 12),
+                   "a " + std::to_string(options.width) + " x " + std::to_string(options.height) + " image");
 
     const auto accel = build_accel(scene, config);
     if (aov == "cost") return render_cost(scene, *accel, options.width, options.height, output);

@@ -26,8 +26,11 @@ int write_rgb(const char* path, int width, int height, const float* rgb, char* e
     auto out = OIIO::ImageOutput::create(path);
     if (!out) return fail(OIIO::geterror(), error, error_size);
     const bool is_exr = std::string(out->format_name()) == "openexr";
-    const OIIO::TypeDesc type = is_exr ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::UINT8;
+    // EXR keeps the renderer's floats exactly (full float, not half).
+    const OIIO::TypeDesc type = is_exr ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8;
     OIIO::ImageSpec spec(width, height, 3, type);
+    // No time stamp: the same render gives the same bytes.
+    spec.attribute("DateTime", "");
     if (!out->open(path, spec)) return fail(out->geterror(), error, error_size);
     std::vector<float> pixels(rgb, rgb + std::size_t(width) * std::size_t(height) * 3);
     if (!is_exr)

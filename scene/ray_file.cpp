@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "scene/atomic_file.h"
+#include "scene/memory_budget.h"
 
 namespace raypack {
 namespace {
@@ -45,6 +46,8 @@ RayFile read_rays(const std::string& path) {
     in.read(reinterpret_cast<char*>(&kind), 4);
     in.read(reinterpret_cast<char*>(&reserved), 4);
     if (kind > 1) fail(path, "unknown ray kind " + std::to_string(kind) + " (expected 0 or 1)");
+    // The rays and the read buffer, 32 bytes each per ray.
+    require_memory(count * 64, path + ": " + std::to_string(count) + " rays");
     RayFile file;
     file.kind = RayKind(kind);
     file.rays.resize(count);
@@ -66,6 +69,7 @@ RayFile read_rays(const std::string& path) {
 std::vector<Hitf> read_hits(const std::string& path) {
     std::uint64_t count = 0;
     std::ifstream in = open_checked(path, kHitsMagic, count, 16, kHitRecord);
+    require_memory(count * sizeof(Hitf), path + ": " + std::to_string(count) + " hits");
     std::vector<Hitf> hits(count);
     for (auto& h : hits) {
         char rec[16];
