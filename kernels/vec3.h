@@ -21,7 +21,9 @@ struct Vec3 {
     constexpr Vec3& operator+=(const Vec3& o) { x += o.x; y += o.y; z += o.z; return *this; }
     constexpr Vec3& operator-=(const Vec3& o) { x -= o.x; y -= o.y; z -= o.z; return *this; }
     constexpr Vec3& operator*=(T s) { x *= s; y *= s; z *= s; return *this; }
-    friend constexpr bool operator==(const Vec3&, const Vec3&) = default;
+    // Not declared constexpr: for lane types (Vec3 of SIMD batches) the
+    // comparison is not, and clang rejects the declaration then.
+    friend bool operator==(const Vec3&, const Vec3&) = default;
 };
 
 using Vec3f = Vec3<float>;

@@ -19,11 +19,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
 class Determinism : public TempDirTest {
 protected:
     /// Runs `raypack ARGS -o FILE` for each variant of `extra` and expects
@@ -35,7 +30,7 @@ protected:
             const std::string cmd = std::string(RAYPACK_CLI) + " " + args + " " + extra[i] + " -o " + out.string() +
                                     " > /dev/null 2>&1";
             ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
-            const std::string bytes = slurp(out);
+            const std::string bytes = file_bytes(out);
             ASSERT_FALSE(bytes.empty()) << cmd;
             if (i == 0) first = bytes;
             else EXPECT_TRUE(bytes == first) << "differs from the first run: " << cmd;

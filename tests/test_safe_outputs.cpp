@@ -22,11 +22,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
 /// Runs `raypack rays` writing 4M camera rays (128 MiB) over `out`, sends
 /// `sig` after `delay_us`, and returns the wait status.
 int write_and_signal(const fs::path& out, int sig, useconds_t delay_us) {
@@ -47,7 +42,7 @@ int write_and_signal(const fs::path& out, int sig, useconds_t delay_us) {
 }
 
 void expect_old_or_complete(const fs::path& out, const std::string& old) {
-    const std::string now = slurp(out);
+    const std::string now = file_bytes(out);
     if (now == old) return;
     // Otherwise the writer finished: the whole new file, readable.
     const RayFile f = read_rays(out.string());
