@@ -22,6 +22,8 @@ namespace raypack {
 namespace {
 
 constexpr float kInvPi = std::numbers::inv_pi_v<float>;
+/// Paths per batch of a tile, at most (and at least one sample per pixel).
+constexpr std::size_t kMaxBatch = 16384;
 
 float max_component(const Vec3f& v) { return std::max({v.x, v.y, v.z}); }
 
@@ -323,22 +325,27 @@ RenderStats render_path(const Scene& scene, const Accel& accel, const WhittedOpt
         if (!mine) mine = std::make_unique<Scratch>();
         Scratch& s = *mine;
         grid.pixels(tile, s.pixels);
-        s.paths.clear();
-        s.keys.clear();
-        s.radiance.assign(s.pixels.size() * std::size_t(spp), Vec3f{});
-        for (const PixelXY& px : s.pixels) {
-            const std::uint64_t pixel = std::uint64_t(px.y) * std::uint64_t(options.width) + std::uint64_t(px.x);
-            for (int k = 0; k < spp; ++k) {
-                Rayf r;
-                sampled_camera_ray(frame, scene.camera, tracer.samples(), options.filter, pixel, px.x, px.y, k, r);
-                s.paths.add(r, {1, 1, 1}, std::uint32_t(s.keys.size()), true);
-                s.keys.push_back(pixel * std::uint64_t(spp) + std::uint64_t(k));
+        // Samples in chunks of about kMaxBatch paths, whatever --spp is.
+        const int chunk = std::max(1, int(kMaxBatch / s.pixels.size()));
+        for (int k0 = 0; k0 < spp; k0 += chunk) {
+            const int k1 = std::min(spp, k0 + chunk);
+            s.paths.clear();
+            s.keys.clear();
+            s.radiance.assign(s.pixels.size() * std::size_t(k1 - k0), Vec3f{});
+            for (const PixelXY& px : s.pixels) {
+                const std::uint64_t pixel = std::uint64_t(px.y) * std::uint64_t(options.width) + std::uint64_t(px.x);
+                for (int k = k0; k < k1; ++k) {
+                    Rayf r;
+                    sampled_camera_ray(frame, scene.camera, tracer.samples(), options.filter, pixel, px.x, px.y, k, r);
+                    s.paths.add(r, {1, 1, 1}, std::uint32_t(s.keys.size()), true);
+                    s.keys.push_back(pixel * std::uint64_t(spp) + std::uint64_t(k));
+                }
             }
+            tracer.trace(s);
+            std::size_t i = 0;
+            for (const PixelXY& px : s.pixels)
+                for (int k = k0; k < k1; ++k) film.add(px.x, px.y, s.radiance[i++]);
         }
-        tracer.trace(s);
-        std::size_t i = 0;
-        for (const PixelXY& px : s.pixels)
-            for (int k = 0; k < spp; ++k) film.add(px.x, px.y, s.radiance[i++]);
         const std::uint64_t done = pixels_done.fetch_add(s.pixels.size(), std::memory_order_relaxed) + s.pixels.size();
         if (options.progress) options.progress(options.progress_context, done, pixels_total);
     });

@@ -29,6 +29,10 @@ RenderStats& RenderStats::operator+=(const RenderStats& o) {
 
 namespace {
 
+/// Eye rays (camera samples) per batch of a tile, at most (and at least one
+/// sample per pixel).
+constexpr std::size_t kMaxBatch = 16384;
+
 /// The ray tree of one batch of eye rays, stored level by level: the rays of
 /// depth d occupy [level_begin, level_end) and their children are appended
 /// after them. Each ray keeps its local colour (ambient and direct light)
@@ -353,24 +357,30 @@ RenderStats render_whitted(const Scene& scene, const Accel& accel, const Whitted
         grid.pixels(tile, s.pixels);
         // The samples of one pixel are consecutive, so packets of eye rays
         // stay within a block of neighbouring pixels.
-        const std::size_t n = s.pixels.size() * std::size_t(spp);
-        s.tree.reset(n);
-        std::size_t i = 0;
-        for (const PixelXY& px : s.pixels) {
-            const std::uint64_t pixel = std::uint64_t(px.y) * std::uint64_t(options.width) + std::uint64_t(px.x);
-            for (int k = 0; k < spp; ++k, ++i) {
-                tracer.camera_sample(px.x, px.y, k, s.tree.rays[i], frame);
-                s.tree.sample[i] = pixel * std::uint64_t(spp) + std::uint64_t(k);
+        // Samples in chunks, so that a batch stays near kMaxBatch eye rays
+        // whatever --spp is (memory grows with the batch's ray tree).
+        const int chunk = std::max(1, int(kMaxBatch / s.pixels.size()));
+        for (int k0 = 0; k0 < spp; k0 += chunk) {
+            const int k1 = std::min(spp, k0 + chunk);
+            const std::size_t n = s.pixels.size() * std::size_t(k1 - k0);
+            s.tree.reset(n);
+            std::size_t i = 0;
+            for (const PixelXY& px : s.pixels) {
+                const std::uint64_t pixel = std::uint64_t(px.y) * std::uint64_t(options.width) + std::uint64_t(px.x);
+                for (int k = k0; k < k1; ++k, ++i) {
+                    tracer.camera_sample(px.x, px.y, k, s.tree.rays[i], frame);
+                    s.tree.sample[i] = pixel * std::uint64_t(spp) + std::uint64_t(k);
+                }
             }
-        }
-        tracer.trace(n, s);
-        i = 0;
-        for (const PixelXY& px : s.pixels) {
-            if (spp == 1) {
-                image.set(px.x, px.y, s.tree.color[i++]);  // Whitted: exactly the ray's colour
-                continue;
+            tracer.trace(n, s);
+            i = 0;
+            for (const PixelXY& px : s.pixels) {
+                if (spp == 1) {
+                    image.set(px.x, px.y, s.tree.color[i++]);  // Whitted: exactly the ray's colour
+                    continue;
+                }
+                for (int k = k0; k < k1; ++k) film->add(px.x, px.y, s.tree.color[i++]);
             }
-            for (int k = 0; k < spp; ++k) film->add(px.x, px.y, s.tree.color[i++]);
         }
         const std::uint64_t done = pixels_done.fetch_add(s.pixels.size(), std::memory_order_relaxed) + s.pixels.size();
         if (options.progress) options.progress(options.progress_context, done, pixels_total);
