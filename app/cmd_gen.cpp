@@ -6,13 +6,21 @@
 #include "app/commands.h"
 #include "scene/atomic_file.h"
 #include "scene/spd/spd.h"
+#include "scene/spd/variants.h"
 
 namespace raypack::app {
 
 int run_gen(const Args& args) {
-    const ParsedArgs p(args, {{"--size", "-s", 1}, {"--output", "-o", 1}}, 1);
+    const ParsedArgs p(args,
+                       {{"--size", "-s", 1}, {"--output", "-o", 1}, {"--area-lights", "", 0}, {"--lens", "", 0},
+                        {"--glossy", "", 0}},
+                       1);
     if (p.help() || p.positional().empty()) {
-        std::printf("usage: raypack gen NAME --size S -o FILE.nff\ngenerators (default size, max):");
+        std::printf("usage: raypack gen NAME --size S [--area-lights] [--lens] [--glossy] -o FILE.nff\n"
+                    "  --area-lights  point lights become spherical area lights (ls)\n"
+                    "  --lens         a thin lens focused on the view point (lens)\n"
+                    "  --glossy       glossy instead of mirror surfaces (gloss 40)\n"
+                    "generators (default size, max):");
         for (const auto& g : spd_generators()) std::printf(" %s (%d, %d)", g.name.c_str(), g.default_size, g.max_size);
         std::printf("\n");
         if (!p.help()) throw UsageError("missing generator NAME");
@@ -30,6 +38,11 @@ int run_gen(const Args& args) {
     std::string text;
     try {
         text = generate_spd(name, size);
+        SceneVariants v;
+        v.area_lights = p.has("--area-lights");
+        v.lens = p.has("--lens");
+        v.glossy = p.has("--glossy");
+        if (v.any()) text = apply_scene_variants(text, v);
     } catch (const std::invalid_argument& e) {
         throw UsageError(e.what());
     }

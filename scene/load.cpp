@@ -5,12 +5,14 @@
 #include <cctype>
 #include <filesystem>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string_view>
 
 #include "scene/nff_text.h"
 #include "scene/number_token.h"
 #include "scene/spd/spd.h"
+#include "scene/spd/variants.h"
 
 namespace raypack {
 
@@ -27,7 +29,17 @@ Scene load_generated(const std::string& spec) {
     if (colon == std::string_view::npos || colon == 0)
         throw SceneError(spec, 0, "bad generator spec: expected gen:NAME:SIZE");
     const std::string name(rest.substr(0, colon));
-    const std::string_view size_text = rest.substr(colon + 1);
+    std::string_view size_text = rest.substr(colon + 1);
+    // gen:NAME:SIZE:VARIANTS, e.g. gen:balls:4:area-lights+lens (scene/spd/variants.h).
+    std::optional<SceneVariants> variants;
+    if (const std::size_t second = size_text.find(':'); second != std::string_view::npos) {
+        variants = parse_scene_variants(size_text.substr(second + 1));
+        if (!variants || !variants->any())
+            throw SceneError(spec, 0,
+                             "bad generator spec: variants '" + std::string(size_text.substr(second + 1)) +
+                                 "' (expected area-lights, lens, glossy joined by '+')");
+        size_text = size_text.substr(0, second);
+    }
     long long size = 0;
     if (size_text.empty()) throw SceneError(spec, 0, "bad generator spec: missing SIZE in gen:NAME:SIZE");
     const NumberToken r = parse_int_token(size_text, size);
@@ -38,6 +50,7 @@ Scene load_generated(const std::string& spec) {
     std::string text;
     try {
         text = generate_spd(name, int(size));
+        if (variants) text = apply_scene_variants(text, *variants);
     } catch (const std::invalid_argument& e) {
         throw SceneError(spec, 0, std::string("bad generator spec: ") + e.what());
     }

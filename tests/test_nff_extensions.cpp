@@ -173,3 +173,33 @@ TEST(Cornell, GeneratedBoxMatchesThePublishedGeometry) {
     for (std::size_t i = 0; i < 2; ++i)  // resting on the floor
         EXPECT_EQ(spheres.spheres.center[i].y, spheres.spheres.radius[i]);
 }
+
+TEST(SceneVariants, GeneratedScenesWithAreaLightsLensAndGloss) {
+    const Scene plain = raypack::load_scene("gen:balls:2");
+    const Scene all = raypack::load_scene("gen:balls:2:area-lights+lens+glossy");
+    // Every point light becomes a sphere light where it was.
+    EXPECT_TRUE(all.lights.empty());
+    ASSERT_EQ(all.area_lights.size(), plain.lights.size());
+    const float distance = length(plain.camera.from - plain.camera.at);
+    for (std::size_t i = 0; i < plain.lights.size(); ++i) {
+        EXPECT_EQ(all.area_lights[i].center, plain.lights[i].position);
+        EXPECT_NEAR(all.area_lights[i].radius, 0.05f * distance, 1e-4f * distance);
+    }
+    EXPECT_EQ(all.light_count(), plain.light_count());  // the SPD intensity stays the same
+    EXPECT_NEAR(all.camera.focus_distance, distance, 1e-4f * distance);
+    EXPECT_NEAR(all.camera.lens_radius, 0.02f * distance, 1e-4f * distance);
+    EXPECT_TRUE(all.features.glossy && all.features.thin_lens && all.features.area_lights);
+    for (std::uint32_t p = 0; p < all.primitive_count(); ++p) {
+        const auto& m = all.materials[all.prim_material[p]];
+        if (m.area_light < 0) {
+            EXPECT_EQ(m.gloss, 40.0f);  // every surface but the lights' own
+        }
+    }
+    // The geometry is the plain scene's plus the lights' spheres.
+    EXPECT_EQ(all.primitive_count(), plain.primitive_count() + plain.lights.size());
+    const Scene lens_only = raypack::load_scene("gen:tetra:2:lens");
+    EXPECT_TRUE(lens_only.features.thin_lens);
+    EXPECT_FALSE(lens_only.features.area_lights || lens_only.features.glossy);
+    EXPECT_THROW(raypack::load_scene("gen:balls:2:fog"), raypack::SceneError);
+    EXPECT_THROW(raypack::load_scene("gen:balls:2:"), raypack::SceneError);
+}
