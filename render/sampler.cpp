@@ -66,7 +66,7 @@ std::uint32_t permute(std::uint32_t i, std::uint32_t n, std::uint32_t key) {
         i &= w;
         i ^= i >> 5;
     } while (i >= n);
-    return (i + key) % n;
+    return (n & (n - 1)) == 0 ? (i + key) & (n - 1) : (i + key) % n;  // no division for powers of two
 }
 
 std::uint32_t reverse_bits(std::uint32_t x) {
