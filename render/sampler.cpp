@@ -135,7 +135,9 @@ Sampler::Sampler(SamplerKind kind, int spp, std::uint64_t seed)
     : kind_(kind), spp_(spp), seed_(seed), seed_hash_(mix(seed + 0x9E3779B97F4A7C15ull)),
       grid_(strata_grid(spp)),
       inv_nx_(1.0 / grid_.nx),
-      inv_ny_(1.0 / grid_.ny) {}
+      inv_ny_(1.0 / grid_.ny),
+      log2_nx_(std::has_single_bit(unsigned(grid_.nx)) ? std::countr_zero(unsigned(grid_.nx)) : -1),
+      log2_ny_(std::has_single_bit(unsigned(grid_.ny)) ? std::countr_zero(unsigned(grid_.ny)) : -1) {}
 
 Sample2 Sampler::get(std::uint64_t pixel, int index, int dimension) const {
     const auto n = std::uint32_t(spp_), i = std::uint32_t(index);
@@ -160,6 +162,16 @@ Sample2 Sampler::get(std::uint64_t pixel, int index, int dimension) const {
             // The jitter of sample i: one more mix of the (pixel, dimension) key.
             const std::uint64_t jitter = mix(key + 0x9E3779B97F4A7C15ull * (std::uint64_t(i) + 1));
             const auto nx = std::uint32_t(grid_.nx), ny = std::uint32_t(grid_.ny);
+            if (log2_nx_ >= 0 && log2_ny_ >= 0) {
+                // Power-of-two strata: c + jitter with 24 - log2(n) bits of
+                // jitter is exact in float and so is the scaling by 1 / n, so the
+                // point stays in its stratum with no check (the common spp 1,
+                // 4, 16, 64, 256 ...).
+                const std::uint32_t cx = cell & (nx - 1), cy = cell >> log2_nx_;
+                const float jx = float(std::uint32_t(jitter) >> (8 + log2_nx_)) * std::ldexp(1.0f, log2_nx_ - 24);
+                const float jy = float(std::uint32_t(jitter >> 32) >> (8 + log2_ny_)) * std::ldexp(1.0f, log2_ny_ - 24);
+                return {(float(cx) + jx) * float(inv_nx_), (float(cy) + jy) * float(inv_ny_)};
+            }
             const std::uint32_t cy = cell / nx, cx = cell - cy * nx;
             return {in_stratum(cx, nx, inv_nx_, std::uint32_t(jitter)), in_stratum(cy, ny, inv_ny_, std::uint32_t(jitter >> 32))};
         }

@@ -51,6 +51,7 @@ private:
     std::uint64_t seed_hash_;  ///< the seed's hash, computed once
     StrataGrid grid_;
     double inv_nx_, inv_ny_;
+    int log2_nx_, log2_ny_;  ///< -1 unless the grid side is a power of two
 };
 
 }  // namespace raypack
