@@ -235,6 +235,7 @@ int run_render(const Args& args) {
                      {"refract", stats.refract_rays},
                      {"diffuse", stats.diffuse_rays}};
         j["mrays_per_s"] = mrays;
+        if (options.distribution) j["noise_rms"] = stats.noise_rms;
         j["output"] = std::filesystem::absolute(output).string();
         std::printf("%s\n", j.dump().c_str());
         return 0;
@@ -255,6 +256,8 @@ int run_render(const Args& args) {
                 options.secondary_packet, offset_policy_name(options.offset),
                 integrator == "path" ? "Path" : options.distribution ? "Distribution" : "Whitted", stats.render_ms,
                 mrays);
+    if (options.distribution)
+        std::printf("  noise      %.3g RMS standard error of the pixel means\n", stats.noise_rms);
     if (options.distribution)
         std::printf("  sampling   %d samples per pixel (%s, %s filter, seed %llu), %s\n", options.spp,
                     sampler_name(options.sampler), pixel_filter_name(options.filter),

@@ -1,5 +1,6 @@
 #include "render/film.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -50,6 +51,23 @@ Image Film::resolve() const {
             out.set(x, y, n > 0 ? sum_.at(x, y) / float(n) : Vec3f{});
         }
     return out;
+}
+
+double Film::noise_rms() const {
+    double total = 0;
+    std::size_t values = 0;
+    for (int y = 0; y < sum_.height; ++y)
+        for (int x = 0; x < sum_.width; ++x) {
+            const int n = count_[std::size_t(y) * std::size_t(sum_.width) + std::size_t(x)];
+            if (n < 2) continue;
+            for (int c = 0; c < 3; ++c) {
+                const double mean = double(sum_.at(x, y)[c]) / n;
+                const double var = std::max(0.0, (double(sum_sq_.at(x, y)[c]) - n * mean * mean) / (n - 1));
+                total += var / n;
+                ++values;
+            }
+        }
+    return values ? std::sqrt(total / double(values)) : 0.0;
 }
 
 }  // namespace raypack

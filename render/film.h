@@ -25,18 +25,25 @@ const char* pixel_filter_name(PixelFilter filter);
 /// filter by the unit-square point `u`.
 Sample2 filter_offset(PixelFilter filter, Sample2 u);
 
-/// Sums of samples per pixel, resolved into their average.
+/// Sums of samples per pixel (and of their squares), resolved into their
+/// average and an estimate of its noise.
 class Film {
 public:
-    Film(int width, int height) : sum_(width, height), count_(std::size_t(width) * std::size_t(height), 0) {}
+    Film(int width, int height)
+        : sum_(width, height), sum_sq_(width, height), count_(std::size_t(width) * std::size_t(height), 0) {}
     void add(int x, int y, const Vec3f& color) {
         sum_.set(x, y, sum_.at(x, y) + color);
+        sum_sq_.set(x, y, sum_sq_.at(x, y) + color * color);
         ++count_[std::size_t(y) * std::size_t(sum_.width) + std::size_t(x)];
     }
     Image resolve() const;
+    /// The standard error of each pixel's mean (sample variance / count,
+    /// per channel), as the root mean square over pixels and channels: how
+    /// far the image is likely to be from the converged one.
+    double noise_rms() const;
 
 private:
-    Image sum_;
+    Image sum_, sum_sq_;
     std::vector<int> count_;
 };
 

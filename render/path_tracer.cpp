@@ -351,6 +351,7 @@ RenderStats render_path(const Scene& scene, const Accel& accel, const WhittedOpt
     });
     image = film.resolve();
     RenderStats stats;
+    stats.noise_rms = film.noise_rms();
     for (const auto& s : scratch)
         if (s) stats += s->stats;
     stats.render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

@@ -385,8 +385,11 @@ RenderStats render_whitted(const Scene& scene, const Accel& accel, const Whitted
         const std::uint64_t done = pixels_done.fetch_add(s.pixels.size(), std::memory_order_relaxed) + s.pixels.size();
         if (options.progress) options.progress(options.progress_context, done, pixels_total);
     });
-    if (film) image = film->resolve();
     RenderStats stats;
+    if (film) {
+        image = film->resolve();
+        stats.noise_rms = film->noise_rms();
+    }
     for (const auto& s : scratch)
         if (s) stats += s->stats;
     stats.render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

@@ -58,6 +58,8 @@ struct RenderStats {
     std::uint64_t shadow_rays = 0;
     std::uint64_t diffuse_rays = 0;  ///< path tracing's diffuse bounces
     double render_ms = 0;
+    /// Sampled renders: the RMS standard error of the pixel means (Film::noise_rms); 0 for Whitted.
+    double noise_rms = 0;
 
     std::uint64_t total_rays() const { return eye_rays + reflect_rays + refract_rays + shadow_rays + diffuse_rays; }
     RenderStats& operator+=(const RenderStats& o);

@@ -167,6 +167,28 @@ TEST(DistributionRender, SoftShadowOfAnAreaLightHasUmbraPenumbraAndFullLight) {
     EXPECT_NEAR(image.at(column(6), row).x, 0.5f, 1e-6f);  // umbra: ambient alone
 }
 
+TEST(DistributionRender, NoiseEstimateFallsAsOneOverRootSamples) {
+    // Random sampling: the standard error of a pixel mean is sigma / sqrt(n),
+    // so 4x the samples halve the estimate; and it predicts the actual error
+    // against a converged render.
+    const Scene s = load_scene("gen:cornell:1");
+    const auto accel = build_accel(s, AccelConfig{});
+    WhittedOptions o = distribution(16, SamplerKind::Random);
+    o.light_samples = 1;
+    Image i16, i64, reference;
+    const double n16 = render_whitted(s, *accel, o, i16).noise_rms;
+    o.spp = 64;
+    const double n64 = render_whitted(s, *accel, o, i64).noise_rms;
+    EXPECT_NEAR(n16 / n64, 2.0, 0.2);
+    o.spp = 2048;
+    o.sampler = SamplerKind::Sobol;
+    render_whitted(s, *accel, o, reference);
+    double sum = 0;
+    for (std::size_t i = 0; i < i16.rgb.size(); ++i) sum += std::pow(double(i16.rgb[i]) - reference.rgb[i], 2);
+    const double error = std::sqrt(sum / double(i16.rgb.size()));
+    EXPECT_NEAR(error / n16, 1.0, 0.2) << "measured error " << error << ", estimated " << n16;
+}
+
 TEST(DistributionRender, SameImageForAnyThreadCount) {
     const Scene s = load_scene("gen:cornell:2");
     const auto accel = build_accel(s, AccelConfig{});
