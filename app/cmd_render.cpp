@@ -98,7 +98,8 @@ int run_render(const Args& args) {
                              {"--aov", "", 1}, offset_option_spec(), {"--json", "", 0},
                              {"--quiet", "-q", 0}, {"--integrator", "", 1}, {"--spp", "", 1}, {"--sampler", "", 1},
                              {"--seed", "", 1}, {"--light-samples", "", 1}, {"--filter", "", 1},
-                             {"--rr-depth", "", 1}, {"--exposure", "", 1}});
+                             {"--rr-depth", "", 1}, {"--exposure", "", 1}, {"--adaptive", "", 1},
+                             {"--adaptive-depth", "", 1}});
     const ParsedArgs p(args, spec, 1);
     if (p.help() || p.positional().empty()) {
         std::printf(
@@ -119,6 +120,9 @@ int run_render(const Args& args) {
             "                --depth caps the path (default 5)\n"
             "  --sampler regular|random|stratified|sobol   (default stratified)\n"
             "  --light-samples N  distribution: shadow rays per area light per sample (default 1)\n"
+            "  --adaptive T  distribution: adaptive supersampling instead of --spp: pixel corners, and\n"
+            "                squares whose corners differ by T split in four (POV-Ray's +AM2)\n"
+            "  --adaptive-depth D  levels of splitting (default 3: down to 1/8 of a pixel)\n"
             "  --filter box|tent|gaussian  pixel filter (default box)\n"
             "  --seed S      random numbers of the samplers (default 1)\n"
             "  --exposure E  multiply the image by E before writing it (default 1)\n"
@@ -145,6 +149,11 @@ int run_render(const Args& args) {
         if (p.has(flag) && !options.distribution)
             throw UsageError(std::string(flag) + " needs --integrator distribution or path");
     if (p.has("--rr-depth") && integrator != "path") throw UsageError("--rr-depth needs --integrator path");
+    for (const char* flag : {"--adaptive", "--adaptive-depth"})
+        if (p.has(flag) && integrator != "distribution") throw UsageError(std::string(flag) + " needs --integrator distribution");
+    if (p.has("--adaptive") && p.has("--spp")) throw UsageError("--adaptive replaces --spp: give one of them");
+    options.adaptive_threshold = float(p.number("--adaptive", 0, 0, 1e30));
+    options.adaptive_depth = int(p.integer("--adaptive-depth", 3, 0, 8));
     if (p.has("--light-samples") && integrator == "path")
         throw UsageError("--light-samples: the path integrator takes one light sample per bounce");
     const float exposure = float(p.number("--exposure", 1.0, 0.0, 1e30));
@@ -210,7 +219,7 @@ int run_render(const Args& args) {
         j["integrator"] = integrator;
         j["width"] = options.width;
         j["height"] = options.height;
-        j["spp"] = options.distribution ? options.spp : 1;
+        j["spp"] = options.distribution && options.adaptive_threshold == 0 ? options.spp : 1;
         if (integrator == "path") j["rr_depth"] = path.rr_depth;
         if (options.distribution) {
             j["sampler"] = sampler_name(options.sampler);
@@ -235,7 +244,12 @@ int run_render(const Args& args) {
                      {"refract", stats.refract_rays},
                      {"diffuse", stats.diffuse_rays}};
         j["mrays_per_s"] = mrays;
-        if (options.distribution) j["noise_rms"] = stats.noise_rms;
+        if (options.distribution && options.adaptive_threshold == 0) j["noise_rms"] = stats.noise_rms;
+        if (options.adaptive_threshold > 0) {
+            j["adaptive"] = options.adaptive_threshold;
+            j["adaptive_depth"] = options.adaptive_depth;
+            j["samples_per_pixel"] = stats.samples_per_pixel;
+        }
         j["output"] = std::filesystem::absolute(output).string();
         std::printf("%s\n", j.dump().c_str());
         return 0;
@@ -256,9 +270,12 @@ int run_render(const Args& args) {
                 options.secondary_packet, offset_policy_name(options.offset),
                 integrator == "path" ? "Path" : options.distribution ? "Distribution" : "Whitted", stats.render_ms,
                 mrays);
-    if (options.distribution)
+    if (options.adaptive_threshold > 0)
+        std::printf("  adaptive   threshold %g, depth %d: %.2f points per pixel\n", options.adaptive_threshold,
+                    options.adaptive_depth, stats.samples_per_pixel);
+    else if (options.distribution)
         std::printf("  noise      %.3g RMS standard error of the pixel means\n", stats.noise_rms);
-    if (options.distribution)
+    if (options.distribution && options.adaptive_threshold == 0)
         std::printf("  sampling   %d samples per pixel (%s, %s filter, seed %llu), %s\n", options.spp,
                     sampler_name(options.sampler), pixel_filter_name(options.filter),
                     (unsigned long long)options.seed,

@@ -144,6 +144,12 @@ public:
         sampled_camera_ray(frame, scene_.camera, samples_, options_.filter, pixel, x, y, index, ray);
     }
 
+    /// The lens point of the sample with key `key` (sampler dimension 1).
+    Sample2 lens_sample(std::uint64_t key) const {
+        const auto spp = std::uint64_t(samples_.spp());
+        return samples_.get(key / spp, int(key % spp), 1);
+    }
+
     /// Traces the whole ray tree of the eye rays s.tree.rays[0 .. eye) (set
     /// after s.tree.reset(eye)); their colours end in s.tree.color[0 .. eye).
     void trace(std::size_t eye, Scratch& s) const {
@@ -338,7 +344,130 @@ private:
 
 }  // namespace
 
+namespace {
+
+/// A square of the image in units of 2^-depth pixels, with the colours at
+/// its corners (top-left, top-right, bottom-left, bottom-right).
+struct Square {
+    std::int64_t x, y;  ///< top-left corner, fine units
+    std::int64_t size;
+    Vec3f c[4];
+};
+
+float max_difference(const Square& q) {
+    float d = 0;
+    for (int a = 0; a < 4; ++a)
+        for (int b = a + 1; b < 4; ++b)
+            for (int ch = 0; ch < 3; ++ch) d = std::max(d, std::fabs(q.c[a][ch] - q.c[b][ch]));
+    return d;
+}
+
+/// Adaptive supersampling (Whitted 1980's adaptive subdivision, as POV-Ray's
+/// +AM2 does it): corners of the pixels first, then every square whose
+/// corners differ by the threshold gets its edge midpoints and centre, level
+/// by level, each level one batch through the wavefront.
+RenderStats render_adaptive(const Scene& scene, const Accel& accel, const WhittedOptions& options, Image& image) {
+    const auto start = std::chrono::steady_clock::now();
+    WhittedOptions point_options = options;
+    point_options.spp = 1;  // one sample per point, keyed by the point
+    point_options.sampler = SamplerKind::Random;
+    const CameraFrame frame = make_camera_frame(scene.camera, options.width, options.height);
+    const WhittedWavefront tracer(scene, accel, point_options);
+    const int depth = std::clamp(options.adaptive_depth, 0, 8);
+    const std::int64_t fine = std::int64_t(1) << depth;                        // fine units per pixel
+    const std::uint64_t row = std::uint64_t(options.width) * std::uint64_t(fine) + 1;  // fine points per row
+    const TileGrid grid{options.width, options.height, options.tile_size};
+    std::vector<std::unique_ptr<Scratch>> scratch(static_cast<std::size_t>(worker_slots()));
+    std::atomic<std::uint64_t> pixels_done{0}, points{0};
+    const std::uint64_t pixels_total = std::uint64_t(options.width) * std::uint64_t(options.height);
+    image = Image(options.width, options.height);
+    for_each_tile(grid, [&](int tile, int slot) {
+        auto& mine = scratch[std::size_t(slot)];
+        if (!mine) mine = std::make_unique<Scratch>();
+        Scratch& s = *mine;
+        const int x0 = (tile % grid.tiles_x()) * grid.tile, y0 = (tile / grid.tiles_x()) * grid.tile;
+        const int x1 = std::min(x0 + grid.tile, options.width), y1 = std::min(y0 + grid.tile, options.height);
+        // Traces points (fine coordinates) as one batch; colours in s.tree.color.
+        std::vector<std::pair<std::int64_t, std::int64_t>> batch;
+        const auto trace_points = [&] {
+            s.tree.reset(batch.size());
+            for (std::size_t i = 0; i < batch.size(); ++i) {
+                const auto [fx, fy] = batch[i];
+                const std::uint64_t key = std::uint64_t(fy) * row + std::uint64_t(fx);
+                const float px = float(double(fx) / double(fine)), py = float(double(fy) / double(fine));
+                s.tree.rays[i] = thin_lens_ray(frame, px, py, tracer.lens_sample(key), scene.camera.lens_radius,
+                                               scene.camera.focus_distance);
+                s.tree.sample[i] = key;
+            }
+            tracer.trace(batch.size(), s);
+            points.fetch_add(batch.size(), std::memory_order_relaxed);
+        };
+        // Level 0: the tile's pixel corners, shared by neighbouring pixels.
+        const int cw = x1 - x0 + 1;
+        batch.clear();
+        for (int y = y0; y <= y1; ++y)
+            for (int x = x0; x <= x1; ++x) batch.emplace_back(std::int64_t(x) * fine, std::int64_t(y) * fine);
+        trace_points();
+        std::vector<Square> squares, next;
+        std::vector<Vec3f> sum(std::size_t((x1 - x0) * (y1 - y0)));
+        for (int y = y0; y < y1; ++y)
+            for (int x = x0; x < x1; ++x) {
+                const std::size_t i = std::size_t((y - y0) * cw + (x - x0));
+                squares.push_back({std::int64_t(x) * fine, std::int64_t(y) * fine, fine,
+                                   {s.tree.color[i], s.tree.color[i + 1], s.tree.color[i + std::size_t(cw)],
+                                    s.tree.color[i + std::size_t(cw) + 1]}});
+            }
+        const auto settle = [&](const Square& q) {
+            const int px = int(q.x / fine) - x0, py = int(q.y / fine) - y0;
+            const float w = float(q.size * q.size) / float(fine * fine) * 0.25f;
+            sum[std::size_t(py * (x1 - x0) + px)] += (q.c[0] + q.c[1] + q.c[2] + q.c[3]) * w;
+        };
+        for (int level = 0; !squares.empty(); ++level) {
+            batch.clear();
+            next.clear();
+            for (const Square& q : squares) {
+                if (level >= depth || max_difference(q) < options.adaptive_threshold) {
+                    settle(q);
+                    continue;
+                }
+                const std::int64_t h = q.size / 2;
+                // Top, left, centre, right, bottom midpoints.
+                for (const auto& [dx, dy] : {std::pair{h, std::int64_t(0)}, std::pair{std::int64_t(0), h},
+                                             std::pair{h, h}, std::pair{q.size, h}, std::pair{h, q.size}})
+                    batch.emplace_back(q.x + dx, q.y + dy);
+                next.push_back(q);
+            }
+            if (next.empty()) break;
+            trace_points();
+            squares.clear();
+            for (std::size_t k = 0; k < next.size(); ++k) {
+                const Square& q = next[k];
+                const Vec3f* m = &s.tree.color[5 * k];  // top, left, centre, right, bottom
+                const std::int64_t h = q.size / 2;
+                squares.push_back({q.x, q.y, h, {q.c[0], m[0], m[1], m[2]}});
+                squares.push_back({q.x + h, q.y, h, {m[0], q.c[1], m[2], m[3]}});
+                squares.push_back({q.x, q.y + h, h, {m[1], m[2], q.c[2], m[4]}});
+                squares.push_back({q.x + h, q.y + h, h, {m[2], m[3], m[4], q.c[3]}});
+            }
+        }
+        for (int y = y0; y < y1; ++y)
+            for (int x = x0; x < x1; ++x) image.set(x, y, sum[std::size_t((y - y0) * (x1 - x0) + (x - x0))]);
+        const std::uint64_t n = std::uint64_t((x1 - x0) * (y1 - y0));
+        const std::uint64_t done = pixels_done.fetch_add(n, std::memory_order_relaxed) + n;
+        if (options.progress) options.progress(options.progress_context, done, pixels_total);
+    });
+    RenderStats stats;
+    for (const auto& sc : scratch)
+        if (sc) stats += sc->stats;
+    stats.samples_per_pixel = double(points) / double(pixels_total);
+    stats.render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return stats;
+}
+
+}  // namespace
+
 RenderStats render_whitted(const Scene& scene, const Accel& accel, const WhittedOptions& options, Image& image) {
+    if (options.distribution && options.adaptive_threshold > 0) return render_adaptive(scene, accel, options, image);
     const auto start = std::chrono::steady_clock::now();
     const CameraFrame frame = make_camera_frame(scene.camera, options.width, options.height);
     const WhittedWavefront tracer(scene, accel, options);

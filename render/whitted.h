@@ -43,6 +43,13 @@ struct WhittedOptions {
     std::uint64_t seed = 1;
     int light_samples = 1;                         ///< shadow rays per area light per camera sample
     PixelFilter filter = PixelFilter::Box;
+    /// Adaptive supersampling instead of spp (distribution only; 0 = off):
+    /// rays through the pixel corners, and a square whose corners differ by
+    /// at least this much in some channel is split in four, down to
+    /// `adaptive_depth` levels (POV-Ray's +AM2 method). Lens, light and lobe
+    /// samples are keyed by the point, so shared corners agree.
+    float adaptive_threshold = 0;
+    int adaptive_depth = 3;
     /// Called after each finished tile with the number of pixels done so far
     /// (from any thread; for progress reports). May be empty.
     void (*progress)(void* context, std::uint64_t pixels_done, std::uint64_t pixels_total) = nullptr;
@@ -58,6 +65,8 @@ struct RenderStats {
     std::uint64_t shadow_rays = 0;
     std::uint64_t diffuse_rays = 0;  ///< path tracing's diffuse bounces
     double render_ms = 0;
+    /// Adaptive supersampling: the points traced per pixel, on average.
+    double samples_per_pixel = 0;
     /// Sampled renders: the RMS standard error of the pixel means (Film::noise_rms); 0 for Whitted.
     double noise_rms = 0;
 

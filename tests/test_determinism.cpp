@@ -52,6 +52,11 @@ TEST_F(Determinism, DistributionImages) {
                        ".exr", kThreadsAndWidths);
 }
 
+TEST_F(Determinism, AdaptiveImages) {
+    expect_same_output("render gen:balls:2:area-lights+lens --res 64 64 --integrator distribution --adaptive 0.1",
+                       ".exr", kThreadsAndWidths);
+}
+
 TEST_F(Determinism, PathImages) {
     expect_same_output("render gen:cornell:2 --res 48 48 --integrator path --spp 4 --depth 6", ".exr",
                        kThreadsAndWidths);
