@@ -316,14 +316,12 @@ RenderStats render_path(const Scene& scene, const Accel& accel, const WhittedOpt
     const PathTracer tracer(scene, accel, options, path);
     const int spp = options.spp;
     const TileGrid grid{options.width, options.height, options.tile_size};
-    std::vector<std::unique_ptr<Scratch>> scratch(static_cast<std::size_t>(worker_slots()));
-    std::atomic<std::uint64_t> pixels_done{0};
-    const std::uint64_t pixels_total = std::uint64_t(options.width) * std::uint64_t(options.height);
+    PerWorker<Scratch> scratch;
+    TileProgress progress(std::uint64_t(options.width) * std::uint64_t(options.height), options.progress,
+                          options.progress_context);
     Film film(options.width, options.height);
     for_each_tile(grid, [&](int tile, int slot) {
-        auto& mine = scratch[std::size_t(slot)];
-        if (!mine) mine = std::make_unique<Scratch>();
-        Scratch& s = *mine;
+        Scratch& s = scratch.at(slot);
         grid.pixels(tile, s.pixels);
         // Samples in chunks of about kMaxBatch paths, whatever --spp is.
         const int chunk = std::max(1, int(kMaxBatch / s.pixels.size()));
@@ -346,14 +344,12 @@ RenderStats render_path(const Scene& scene, const Accel& accel, const WhittedOpt
             for (const PixelXY& px : s.pixels)
                 for (int k = k0; k < k1; ++k) film.add(px.x, px.y, s.radiance[i++]);
         }
-        const std::uint64_t done = pixels_done.fetch_add(s.pixels.size(), std::memory_order_relaxed) + s.pixels.size();
-        if (options.progress) options.progress(options.progress_context, done, pixels_total);
+        progress.add(s.pixels.size());
     });
     image = film.resolve();
     RenderStats stats;
     stats.noise_rms = film.noise_rms();
-    for (const auto& s : scratch)
-        if (s) stats += s->stats;
+    scratch.for_each([&](const Scratch& s) { stats += s.stats; });
     stats.render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return stats;
 }

@@ -377,14 +377,13 @@ RenderStats render_adaptive(const Scene& scene, const Accel& accel, const Whitte
     const std::int64_t fine = std::int64_t(1) << depth;                        // fine units per pixel
     const std::uint64_t row = std::uint64_t(options.width) * std::uint64_t(fine) + 1;  // fine points per row
     const TileGrid grid{options.width, options.height, options.tile_size};
-    std::vector<std::unique_ptr<Scratch>> scratch(static_cast<std::size_t>(worker_slots()));
-    std::atomic<std::uint64_t> pixels_done{0}, points{0};
-    const std::uint64_t pixels_total = std::uint64_t(options.width) * std::uint64_t(options.height);
+    PerWorker<Scratch> scratch;
+    std::atomic<std::uint64_t> points{0};
+    TileProgress progress(std::uint64_t(options.width) * std::uint64_t(options.height), options.progress,
+                          options.progress_context);
     image = Image(options.width, options.height);
     for_each_tile(grid, [&](int tile, int slot) {
-        auto& mine = scratch[std::size_t(slot)];
-        if (!mine) mine = std::make_unique<Scratch>();
-        Scratch& s = *mine;
+        Scratch& s = scratch.at(slot);
         const int x0 = (tile % grid.tiles_x()) * grid.tile, y0 = (tile / grid.tiles_x()) * grid.tile;
         const int x1 = std::min(x0 + grid.tile, options.width), y1 = std::min(y0 + grid.tile, options.height);
         // Traces points (fine coordinates) as one batch; colours in s.tree.color.
@@ -453,13 +452,11 @@ RenderStats render_adaptive(const Scene& scene, const Accel& accel, const Whitte
         for (int y = y0; y < y1; ++y)
             for (int x = x0; x < x1; ++x) image.set(x, y, sum[std::size_t((y - y0) * (x1 - x0) + (x - x0))]);
         const std::uint64_t n = std::uint64_t((x1 - x0) * (y1 - y0));
-        const std::uint64_t done = pixels_done.fetch_add(n, std::memory_order_relaxed) + n;
-        if (options.progress) options.progress(options.progress_context, done, pixels_total);
+        progress.add(n);
     });
     RenderStats stats;
-    for (const auto& sc : scratch)
-        if (sc) stats += sc->stats;
-    stats.samples_per_pixel = double(points) / double(pixels_total);
+    scratch.for_each([&](const Scratch& s) { stats += s.stats; });
+    stats.samples_per_pixel = double(points) / double(progress.total());
     stats.render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return stats;
 }
@@ -473,16 +470,14 @@ RenderStats render_whitted(const Scene& scene, const Accel& accel, const Whitted
     const WhittedWavefront tracer(scene, accel, options);
     const int spp = options.distribution ? options.spp : 1;
     const TileGrid grid{options.width, options.height, options.tile_size};
-    std::vector<std::unique_ptr<Scratch>> scratch(static_cast<std::size_t>(worker_slots()));
-    std::atomic<std::uint64_t> pixels_done{0};
-    const std::uint64_t pixels_total = std::uint64_t(options.width) * std::uint64_t(options.height);
+    PerWorker<Scratch> scratch;
+    TileProgress progress(std::uint64_t(options.width) * std::uint64_t(options.height), options.progress,
+                          options.progress_context);
     std::optional<Film> film;  // Whitted writes the image directly
     if (spp > 1) film.emplace(options.width, options.height);
     image = Image(options.width, options.height);
     for_each_tile(grid, [&](int tile, int slot) {
-        auto& mine = scratch[std::size_t(slot)];
-        if (!mine) mine = std::make_unique<Scratch>();
-        Scratch& s = *mine;
+        Scratch& s = scratch.at(slot);
         grid.pixels(tile, s.pixels);
         // The samples of one pixel are consecutive, so packets of eye rays
         // stay within a block of neighbouring pixels.
@@ -511,16 +506,14 @@ RenderStats render_whitted(const Scene& scene, const Accel& accel, const Whitted
                 for (int k = k0; k < k1; ++k) film->add(px.x, px.y, s.tree.color[i++]);
             }
         }
-        const std::uint64_t done = pixels_done.fetch_add(s.pixels.size(), std::memory_order_relaxed) + s.pixels.size();
-        if (options.progress) options.progress(options.progress_context, done, pixels_total);
+        progress.add(s.pixels.size());
     });
     RenderStats stats;
     if (film) {
         image = film->resolve();
         stats.noise_rms = film->noise_rms();
     }
-    for (const auto& s : scratch)
-        if (s) stats += s->stats;
+    scratch.for_each([&](const Scratch& s) { stats += s.stats; });
     stats.render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return stats;
 }
