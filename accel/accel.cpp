@@ -30,6 +30,7 @@ std::span<const char* const> accel_kinds() {
         "brute",
 #ifdef RAYPACK_HAVE_EMBREE
         "embree",
+        "embree-robust",
 #endif
     };
     return kinds;
@@ -50,7 +51,8 @@ std::unique_ptr<Accel> build_accel(const Scene& scene, const AccelConfig& config
     if (config.kind == "octree") return std::make_unique<OctreeAccel>(scene, config);
     if (config.kind == "brute") return std::make_unique<BruteForce>(scene, config.kernels);
 #ifdef RAYPACK_HAVE_EMBREE
-    if (config.kind == "embree") return std::make_unique<EmbreeAccel>(scene);
+    if (is_embree_kind(config.kind))
+        return std::make_unique<EmbreeAccel>(scene, embree_options(config.kind == "embree-robust", config.build_quality));
 #endif
     throw std::invalid_argument("unknown acceleration structure '" + config.kind + "' (expected " + accel_kinds_list() + ")");
 }

@@ -6,6 +6,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <string_view>
 #include <utility>
 
 #include "accel/primitive_intersector.h"
@@ -49,7 +50,14 @@ struct AccelConfig {
     std::string builder = "binned";
     float spatial_alpha = 1e-5f;     ///< sbvh: overlap (relative to the root) that makes spatial splits worth trying
     float reference_budget = 1.3f;   ///< sbvh: at most this many references per primitive
+    /// embree, embree-robust: Embree's build quality, low | medium | high
+    /// (RTC_BUILD_QUALITY_*; medium is Embree's own default).
+    std::string build_quality = "medium";
 };
+
+/// Embree's two modes: `embree` (its default, fast mode) and `embree-robust`
+/// (RTC_SCENE_FLAG_ROBUST: no hits lost at shared edges, and slower).
+inline bool is_embree_kind(std::string_view kind) { return kind == "embree" || kind == "embree-robust"; }
 
 /// The structure `kind` with the given kernels and every other setting at its
 /// default (designated initializers would leave -Wextra warning about the rest).

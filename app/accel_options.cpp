@@ -8,7 +8,8 @@
 namespace raypack::app {
 
 std::vector<OptionSpec> accel_option_specs() {
-    std::vector<OptionSpec> specs = {{"--accel", "", 1}, {"--packet", "", 1}, {"--builder", "", 1}};
+    std::vector<OptionSpec> specs = {{"--accel", "", 1}, {"--packet", "", 1}, {"--builder", "", 1},
+                                       {"--embree-quality", "", 1}};
     for (OptionSpec& k : kernel_option_specs()) specs.push_back(std::move(k));
     return specs;
 }
@@ -70,6 +71,8 @@ std::string accel_options_help() {
            "  --accel " + accel_kinds_list() + "  acceleration structure (default bvh2)\n"
            "  --builder " + bvh_builder_list() + "  BVH builder for bvh2|bvh4|bvh8 (default binned):\n"
            "                binned SAH, full-sweep SAH, Morton/LBVH, spatial splits (SBVH)\n"
+           "  --embree-quality low|medium|high  Embree's build quality (default medium, Embree's own);\n"
+           "                embree is Embree's fast mode, embree-robust its robust mode\n"
            + kernel_options_help() +
            "  --packet 1|4|8|16             rays per packet (default 1; 16 needs AVX-512)\n";
 }
@@ -111,11 +114,23 @@ AccelConfig accel_config_from(const ParsedArgs& args) {
             throw UsageError("--builder applies to bvh2, bvh4 and bvh8 only, not to --accel " + config.kind);
     }
     config.kernels = kernel_choice_from(args);
-    if (config.kind == "embree")
+    config.build_quality = embree_quality_from(args, config.kind);
+    if (is_embree_kind(config.kind))
         for (const OptionSpec& option : kernel_option_specs())
             if (args.has(option.name))
-                throw UsageError(option.name + " does not apply to --accel embree (Embree runs its own tests)");
+                throw UsageError(option.name + " does not apply to --accel " + config.kind +
+                                 " (Embree runs its own tests)");
     return config;
+}
+
+std::string embree_quality_from(const ParsedArgs& args, const std::string& accels) {
+    if (!args.has("--embree-quality")) return "medium";
+    const std::string quality = args.text("--embree-quality");
+    if (quality != "low" && quality != "medium" && quality != "high")
+        throw UsageError("--embree-quality: expected low|medium|high, got '" + quality + "'");
+    if (accels.find("embree") == std::string::npos)
+        throw UsageError("--embree-quality applies to --accel embree and embree-robust only");
+    return quality;
 }
 
 bool uses_fastest_config(const ParsedArgs& args) {

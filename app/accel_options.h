@@ -23,6 +23,9 @@ const char* rcp_method_name(RcpMethod m);
 /// e.g. "moeller triangles, geometric spheres, robust slabs, exact rcp, float".
 std::string kernel_choice_summary(const KernelChoice& k);
 AccelConfig accel_config_from(const ParsedArgs& args);
+/// --embree-quality low|medium|high (default medium); a usage error unless
+/// `accels` (one kind, or a comma-separated list) names an Embree mode.
+std::string embree_quality_from(const ParsedArgs& args, const std::string& accels);
 /// --packet K, checked against what `accel` traverses natively.
 int packet_width_from(const ParsedArgs& args, const Accel& accel);
 std::string accel_options_help();

@@ -64,6 +64,7 @@ struct BenchPlan {
     OffsetPolicy offset = kDefaultOffset;
     KernelChoice kernels;        ///< --triangle, --sphere, --slabs, --precision, --rcp (not Embree's)
     std::string builder = "binned";  ///< --builder, for bvh2, bvh4, bvh8
+    std::string embree_quality = "medium";  ///< --embree-quality, for embree and embree-robust
     bool quick = false;
 
     /// Embree runs its own tests in float (Moeller triangles) whatever
@@ -71,13 +72,14 @@ struct BenchPlan {
     /// default oracle, as without them.
     bool embree_needs_own_oracle() const {
         const KernelChoice d;
-        return std::find(accels.begin(), accels.end(), "embree") != accels.end() &&
+        return std::any_of(accels.begin(), accels.end(), [](const std::string& a) { return is_embree_kind(a); }) &&
                (kernels.triangle != d.triangle || kernels.sphere != d.sphere || kernels.precision != d.precision);
     }
 
     AccelConfig config(const std::string& kind) const {
         AccelConfig c = accel_config(kind, kernels);
         c.builder = builder;
+        c.build_quality = embree_quality;
         return c;
     }
 };
@@ -104,6 +106,8 @@ void print_help() {
         "                 repeat 3: the CI smoke run; explicit options still apply\n"
         "  --offset P     secondary-ray origins of the shadow and diffuse sets: %s (default %s)\n"
         "  --builder B    BVH builder of bvh2, bvh4, bvh8: %s (default binned)\n"
+        "  --embree-quality Q  build quality of embree (Embree's fast mode) and embree-robust:\n"
+        "                 low|medium|high (default medium, Embree's own)\n"
         "  kernel variants of every structure but Embree (which runs its own):\n%s"
         "  --tradeoff     speed against accuracy of each triangle, sphere, slab, rcp, precision, builder\n"
         "                 and offset variant: throughput, leaks at shared edges and vertices, t error\n"
@@ -156,6 +160,9 @@ BenchPlan plan_from(const ParsedArgs& p) {
         if (!is_bvh_builder(plan.builder))
             throw UsageError("--builder: unknown builder '" + plan.builder + "' (expected " + bvh_builder_list() + ")");
     }
+    std::string accel_list;
+    for (const std::string& a : plan.accels) accel_list += a + ",";
+    plan.embree_quality = embree_quality_from(p, accel_list);
     return plan;
 }
 
@@ -208,7 +215,8 @@ int run_bench(const Args& args) {
     std::vector<OptionSpec> specs = {{"--accel", "", 1}, {"--packet", "", 1}, {"--rays", "", 1},
                                      {"--rays-file", "", 1}, {"--threads", "", 1}, {"--repeat", "", 1},
                                      {"--res", "", 2}, {"--json", "", 1}, {"--csv", "", 1}, {"--quick", "", 0},
-                                     {"--tradeoff", "", 0}, {"--builder", "", 1}, offset_option_spec()};
+                                     {"--tradeoff", "", 0}, {"--builder", "", 1}, {"--embree-quality", "", 1},
+                                     offset_option_spec()};
     for (OptionSpec& k : kernel_option_specs()) specs.push_back(std::move(k));
     const ParsedArgs p(args, specs, 1000);
     if (p.help()) {
@@ -217,7 +225,8 @@ int run_bench(const Args& args) {
     }
     if (p.has("--tradeoff")) {
         for (const char* other : {"--accel", "--packet", "--rays", "--rays-file", "--threads", "--res", "--offset",
-                                  "--builder", "--sphere", "--triangle", "--slabs", "--precision", "--rcp"})
+                                  "--builder", "--sphere", "--triangle", "--slabs", "--precision", "--rcp",
+                                  "--embree-quality"})
             if (p.has(other)) throw UsageError(std::string(other) + " does not apply to --tradeoff (it runs every variant)");
         if (!p.positional().empty()) throw UsageError("--tradeoff takes no SCENE (it builds its own)");
         return run_tradeoff(TradeoffPlan{.quick = p.has("--quick"),
@@ -258,7 +267,7 @@ int run_bench(const Args& args) {
                 for (int packet : widths) {
                     const std::string context =
                         scene_name + " " + accel_kind + " K=" + std::to_string(packet) + " " + set.name;
-                    const bool embree_own = accel_kind == "embree" && plan.embree_needs_own_oracle();
+                    const bool embree_own = is_embree_kind(accel_kind) && plan.embree_needs_own_oracle();
                     validate_against_oracle(*accel, packet, set, embree_own ? embree_samples[s] : samples[s], context);
                     for (int threads : plan.threads) {
                         progress.next(context + " " + std::to_string(threads) + " thread" + (threads > 1 ? "s" : ""));

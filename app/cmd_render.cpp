@@ -263,7 +263,7 @@ int run_render(const Args& args) {
                 "%.2f refs/prim, %.1f KiB, SAH cost %.2f\n",
                 as.name.c_str(), as.builder.c_str(), as.build_ms, as.nodes, as.leaves, as.empty_leaves, as.depth,
                 as.refs_per_prim, double(as.bytes) / 1024.0, as.sah_cost);
-    if (as.name != "embree") std::printf("  kernels    %s\n", kernel_choice_summary(config.kernels).c_str());
+    if (!is_embree_kind(as.name)) std::printf("  kernels    %s\n", kernel_choice_summary(config.kernels).c_str());
     std::printf("  render     %dx%d, depth %d, %d threads, packets of %d (eye) and %d (secondary), offset %s, "
                 "%s: %.1f ms, %.2f Mrays/s\n",
                 options.width, options.height, options.max_depth, limit.threads(), options.packet,

@@ -124,7 +124,7 @@ int run_trace(const Args& args) {
         std::printf("raypack trace: %s, %zu %s rays, %s (%s) built in %.1f ms\n", scene.source.c_str(),
                     file.rays.size(), file.kind == RayKind::ClosestHit ? "closest-hit" : "any-hit", as.name.c_str(),
                     as.builder.c_str(), as.build_ms);
-        if (as.name != "embree") std::printf("  kernels: %s\n", kernel_choice_summary(config.kernels).c_str());
+        if (!is_embree_kind(as.name)) std::printf("  kernels: %s\n", kernel_choice_summary(config.kernels).c_str());
         std::printf("  packets of %d, %d threads, %d passes: median %.2f ms (min %.2f, max %.2f), %.2f Mrays/s; %zu %s\n",
                     packet, limit.threads(), repeat, median, sorted.front(), sorted.back(), mrays, hit_count,
                     file.kind == RayKind::ClosestHit ? "hits" : "occluded");

@@ -94,7 +94,7 @@ void scene_case(benchmark::State& state, const std::string& file, const std::str
 /// bench_wide_bvh.cpp has the single-ray camera and shadow cases of the
 /// wide BVHs and Embree under the same names.
 bool registered_in_bench_wide_bvh(const std::string& kind, const std::string& rays_kind, int packet) {
-    return (kind == "bvh4" || kind == "bvh8" || kind == "embree") && packet == 1 && rays_kind != "diffuse";
+    return (kind == "bvh4" || kind == "bvh8" || is_embree_kind(kind)) && packet == 1 && rays_kind != "diffuse";
 }
 
 /// One case per native width of each structure (asked of a one-sphere scene).

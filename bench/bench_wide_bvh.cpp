@@ -86,7 +86,7 @@ private:
 bool validated(benchmark::State& state, const Accel& accel, const Scene& scene, const std::vector<Rayf>& rays,
                bool shadow) {
     const BruteForce oracle(scene, KernelChoice{});
-    const bool own_kernels = accel.stats().name != "embree";
+    const bool own_kernels = !is_embree_kind(accel.stats().name);
     std::size_t bad = 0, checked = 0;
     for (std::size_t i = 0; i < rays.size(); i += 61, ++checked) {
         if (shadow) {
@@ -135,7 +135,7 @@ bool packets_agree(benchmark::State& state, const Accel& accel, int width, bool 
     std::vector<std::uint8_t> occ_one(rays.size()), occ_packet(rays.size());
     trace(accel, 1, shadow, rays, one, occ_one);
     trace(accel, width, shadow, rays, packet, occ_packet);
-    const float rel = accel.stats().name == "embree" ? 1e-4f : 1e-5f;
+    const float rel = is_embree_kind(accel.stats().name) ? 1e-4f : 1e-5f;
     std::size_t bad = 0;
     for (std::size_t i = 0; i < rays.size(); ++i)
         bad += shadow ? occ_one[i] != occ_packet[i]
@@ -193,6 +193,7 @@ int register_cases() {
     std::vector<std::string> kinds = {"bvh4", "bvh8"};
 #ifdef RAYPACK_HAVE_EMBREE
     kinds.push_back("embree");
+    kinds.push_back("embree-robust");
 #endif
     for (const char* name : {"balls", "mount", "tetra", "teapot", "bunny"}) {
         const std::string file = std::string(name) + (std::string(name) == "bunny" ? ".obj" : ".nff");

@@ -43,6 +43,7 @@ std::vector<std::string> accel_kinds_under_test() {
     std::vector<std::string> kinds = {"bvh2"};
 #ifdef RAYPACK_HAVE_EMBREE
     kinds.push_back("embree");
+    kinds.push_back("embree-robust");
 #endif
     return kinds;
 }

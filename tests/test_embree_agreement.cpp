@@ -271,34 +271,35 @@ TEST_P(EmbreeAgreement, PacketsMatchSingleRays) {
     }
 }
 
-/// A batch whose rays share one origin runs in Embree's coherent context; one
-/// ray from elsewhere appended to it makes the same batch incoherent. The
-/// camera rays must get the same answers both ways, at every width.
+/// A packet whose rays share one origin runs in Embree's coherent context.
+/// The camera rays must get the same answers as in the incoherent context, at
+/// every width, also when a ray from elsewhere makes one packet incoherent.
 TEST_P(EmbreeAgreement, CoherentContextMatchesIncoherent) {
     const Scene scene = load_scene(std::string(RAYPACK_SOURCE_DIR) + "/scenes/" + GetParam());
     const EmbreeAccel embree(scene);
+    EmbreeOptions incoherent_options;
+    incoherent_options.context = EmbreeContext::Incoherent;
+    const EmbreeAccel incoherent(scene, incoherent_options);
     const int size = 96;
     const CameraFrame f = make_camera_frame(scene.camera, size, size);
-    std::vector<Rayf> coherent;
+    std::vector<Rayf> rays;
     for (int y = 0; y < size; ++y)
-        for (int x = 0; x < size; ++x) coherent.push_back(camera_ray(f, float(x) + 0.5f, float(y) + 0.5f));
-    std::vector<Rayf> mixed = coherent;
-    Rayf stray = coherent[0];
-    stray.org = stray.org + Vec3f{1.0f, 1.0f, 1.0f};
-    mixed.push_back(stray);
+        for (int x = 0; x < size; ++x) rays.push_back(camera_ray(f, float(x) + 0.5f, float(y) + 0.5f));
+    rays[size * size / 2 + 3].org = rays[0].org + Vec3f{1.0f, 1.0f, 1.0f};  // one packet loses its single origin
     for (int width : {1, 4, 8, 16}) {
         SCOPED_TRACE("width " + std::to_string(width) + " on " + GetParam());
-        std::vector<Hitf> a(coherent.size()), b(mixed.size());
-        embree.intersect_packets(width, coherent, a);
-        embree.intersect_packets(width, mixed, b);
-        std::vector<std::uint8_t> oa(coherent.size()), ob(mixed.size());
-        embree.occluded_packets(width, coherent, oa);
-        embree.occluded_packets(width, mixed, ob);
+        std::vector<Hitf> a(rays.size()), b(rays.size());
+        embree.intersect_packets(width, rays, a);
+        incoherent.intersect_packets(width, rays, b);
+        std::vector<std::uint8_t> oa(rays.size()), ob(rays.size());
+        embree.occluded_packets(width, rays, oa);
+        incoherent.occluded_packets(width, rays, ob);
         std::size_t unlike = 0, hits = 0, occ_unlike = 0;
-        for (std::size_t i = 0; i < coherent.size(); ++i) {
+        for (std::size_t i = 0; i < rays.size(); ++i) {
             hits += a[i].found();
             unlike += a[i].found() != b[i].found() || a[i].prim != b[i].prim ||
-                      std::fabs(a[i].t - b[i].t) > 1e-6f * std::max(a[i].t, b[i].t);
+                      std::fabs(a[i].t - b[i].t) > 1e-6f * std::max(a[i].t, b[i].t) || a[i].u != b[i].u ||
+                      a[i].v != b[i].v;
             occ_unlike += oa[i] != ob[i];
         }
         EXPECT_GT(hits, 0u) << "the camera sees nothing: the test would prove nothing";
@@ -454,6 +455,46 @@ TEST_F(EmbreeAgreement, ReportsNativePacketWidths) {
     std::vector<std::uint8_t> occ(3);
     e.occluded_packets(16, rays, occ);
     EXPECT_EQ(occ, (std::vector<std::uint8_t>{1, 0, 1}));
+}
+
+/// `embree` is Embree's fast mode and `embree-robust` its robust one, each at
+/// the build quality asked for; every combination answers the camera and
+/// shadow rays of a triangle scene as the default does but for a few rays at
+/// shared edges, and says how it was run.
+TEST_F(EmbreeAgreement, ModesAndBuildQualities) {
+    const Scene scene = load_scene(std::string(RAYPACK_SOURCE_DIR) + "/scenes/tetra.nff");
+    const int size = 128;
+    const CameraFrame f = make_camera_frame(scene.camera, size, size);
+    std::vector<Rayf> rays;
+    for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x) rays.push_back(camera_ray(f, float(x) + 0.5f, float(y) + 0.5f));
+    const EmbreeAccel reference(scene);
+    EXPECT_EQ(reference.stats().name, "embree");
+    EXPECT_EQ(reference.stats().builder.rfind("fast mode, medium quality, ", 0), 0u) << reference.stats().builder;
+    const std::vector<Hitf> want = trace(reference, rays);
+    for (const char* kind : {"embree", "embree-robust"})
+        for (const char* quality : {"low", "medium", "high"}) {
+            SCOPED_TRACE(std::string(kind) + " " + quality);
+            AccelConfig config = accel_config(kind);
+            config.build_quality = quality;
+            const auto accel = build_accel(scene, config);
+            EXPECT_EQ(accel->stats().name, kind);
+            const std::string mode = std::string(kind) == "embree" ? "fast" : "robust";
+            EXPECT_EQ(accel->stats().builder.rfind(mode + " mode, " + quality + " quality", 0), 0u)
+                << accel->stats().builder;
+            const std::vector<Hitf> got = trace(*accel, rays);
+            std::size_t unlike = 0, hits = 0;
+            for (std::size_t i = 0; i < rays.size(); ++i) {
+                hits += want[i].found();
+                unlike += want[i].found() != got[i].found() ||
+                          (want[i].found() && std::fabs(want[i].t - got[i].t) > kRelT * want[i].t);
+            }
+            EXPECT_GT(hits, rays.size() / 8);  // tetra covers about a fifth of the frame
+            EXPECT_LE(double(unlike), (1.0 - kRequired) * double(rays.size())) << unlike << " rays differ";
+        }
+    EXPECT_THROW(embree_options(false, "ultra"), std::invalid_argument);
+    EXPECT_TRUE(embree_options(true, "high").robust);
+    EXPECT_EQ(embree_options(false, "low").quality, RTC_BUILD_QUALITY_LOW);
 }
 
 TEST_F(EmbreeAgreement, ConePacketsUseEveryLane) {

@@ -1,4 +1,6 @@
 #include "accel/embree/embree_accel.h"
+#include "accel/embree/embree_packet_io.h"
+#include "accel/embree/embree_packet_types.h"
 
 #ifdef RAYPACK_HAVE_EMBREE
 
@@ -36,19 +38,10 @@ private:
     unsigned ftz_, daz_;
 };
 
-/// The intersect context for one batch. Embree's coherent mode (its frustum
-/// packet traversal, BVHNIntersectorKHybrid::intersectCoherent) is a promise
-/// about the rays; raypack keeps it exactly when every ray of the batch
-/// starts at one origin (camera rays), the same property raypack's default
-/// configuration keys on (app/default_config). The check is one pass of
-/// compares, exact, and needs no hint from the caller.
-RTCIntersectContext context_for(std::span<const Rayf> rays) {
+RTCIntersectContext make_context(bool coherent) {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
-    const bool one_origin = std::all_of(rays.begin(), rays.end(), [&](const Rayf& r) {
-        return r.org.x == rays[0].org.x && r.org.y == rays[0].org.y && r.org.z == rays[0].org.z;
-    });
-    if (one_origin && !rays.empty()) context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    if (coherent) context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
     return context;
 }
 
@@ -207,57 +200,27 @@ void cone_occluded(const RTCOccludedFunctionNArguments* args) {
     }
 }
 
-// ---- Packets of K rays -------------------------------------------------------
-//
-// Embree's packet types carry their own alignment (RTC_ALIGN(16/32/64) on
-// RTCRayHit4/8/16), which holds for locals; the valid masks get the same.
-
-template <int K> struct EmbreePacket;
-template <> struct EmbreePacket<4> {
-    using RayHit = RTCRayHit4;
-    using Ray = RTCRay4;
-    static void intersect(const int* v, RTCScene s, RTCIntersectContext* c, RayHit* r) { rtcIntersect4(v, s, c, r); }
-    static void occluded(const int* v, RTCScene s, RTCIntersectContext* c, Ray* r) { rtcOccluded4(v, s, c, r); }
-};
-template <> struct EmbreePacket<8> {
-    using RayHit = RTCRayHit8;
-    using Ray = RTCRay8;
-    static void intersect(const int* v, RTCScene s, RTCIntersectContext* c, RayHit* r) { rtcIntersect8(v, s, c, r); }
-    static void occluded(const int* v, RTCScene s, RTCIntersectContext* c, Ray* r) { rtcOccluded8(v, s, c, r); }
-};
-template <> struct EmbreePacket<16> {
-    using RayHit = RTCRayHit16;
-    using Ray = RTCRay16;
-    static void intersect(const int* v, RTCScene s, RTCIntersectContext* c, RayHit* r) { rtcIntersect16(v, s, c, r); }
-    static void occluded(const int* v, RTCScene s, RTCIntersectContext* c, Ray* r) { rtcOccluded16(v, s, c, r); }
-};
 static_assert(alignof(RTCRayHit4) >= 16 && alignof(RTCRayHit8) >= 32 && alignof(RTCRayHit16) >= 64);
 
-/// Fills lanes [0, K) of `ray` from up to K rays and sets `valid`: -1 for a
-/// ray, 0 for the lanes past the end (which repeat the last ray, so that
-/// even an inactive lane holds finite numbers).
-template <int K, class RayK>
-void load_embree_packet(std::span<const Rayf> rays, RayK& ray, int (&valid)[K]) {
-    for (int i = 0; i < K; ++i) {
-        const std::size_t src = std::min<std::size_t>(std::size_t(i), rays.size() - 1);
-        const Rayf& r = rays[src];
-        ray.org_x[i] = r.org.x;
-        ray.org_y[i] = r.org.y;
-        ray.org_z[i] = r.org.z;
-        ray.tnear[i] = r.tnear;
-        ray.dir_x[i] = r.dir.x;
-        ray.dir_y[i] = r.dir.y;
-        ray.dir_z[i] = r.dir.z;
-        ray.time[i] = 0.0f;
-        ray.tfar[i] = r.tfar;
-        ray.mask[i] = 0xFFFFFFFFu;
-        ray.id[i] = unsigned(i);
-        ray.flags[i] = 0;
-        valid[i] = std::size_t(i) < rays.size() ? -1 : 0;
-    }
+}  // namespace
+
+EmbreeOptions embree_options(bool robust, const std::string& quality) {
+    EmbreeOptions options;
+    options.robust = robust;
+    if (quality == "low") options.quality = RTC_BUILD_QUALITY_LOW;
+    else if (quality == "medium") options.quality = RTC_BUILD_QUALITY_MEDIUM;
+    else if (quality == "high") options.quality = RTC_BUILD_QUALITY_HIGH;
+    else throw std::invalid_argument("unknown Embree build quality '" + quality + "' (expected low|medium|high)");
+    return options;
 }
 
-}  // namespace
+const char* embree_quality_name(RTCBuildQuality quality) {
+    switch (quality) {
+        case RTC_BUILD_QUALITY_LOW: return "low";
+        case RTC_BUILD_QUALITY_HIGH: return "high";
+        default: return "medium";
+    }
+}
 
 bool EmbreeAccel::memory_monitor(void* self, ssize_t bytes, bool /*post*/) {
     static_cast<EmbreeAccel*>(self)->allocated_.fetch_add(std::int64_t(bytes), std::memory_order_relaxed);
@@ -280,7 +243,7 @@ void EmbreeAccel::fail(const std::string& what) const {
     throw std::runtime_error("embree: " + what + (detail.empty() ? "" : " (" + detail + ")"));
 }
 
-EmbreeAccel::EmbreeAccel(const Scene& scene) {
+EmbreeAccel::EmbreeAccel(const Scene& scene, EmbreeOptions options) {
     device_ = rtcNewDevice(nullptr);
     if (!device_) throw std::runtime_error("embree: rtcNewDevice failed (error " +
                                            std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
@@ -288,9 +251,10 @@ EmbreeAccel::EmbreeAccel(const Scene& scene) {
     rtcSetDeviceMemoryMonitorFunction(device_, &EmbreeAccel::memory_monitor, this);
     // Timed from the scene on, like our builders: an application creates
     // the device once, and pays the scene set-up and commit per scene.
+    options_ = options;
     const auto start = std::chrono::steady_clock::now();
     try {
-        build(scene);
+        build(scene, options);
     } catch (...) {
         // The destructor does not run for a constructor that throws.
         if (scene_) rtcReleaseScene(scene_);
@@ -298,20 +262,21 @@ EmbreeAccel::EmbreeAccel(const Scene& scene) {
         throw;
     }
     const auto stop = std::chrono::steady_clock::now();
-    stats_.name = "embree";
+    stats_.name = options.robust ? "embree-robust" : "embree";
     native_[0] = rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_NATIVE_RAY4_SUPPORTED) != 0;
     native_[1] = rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED) != 0;
     native_[2] = rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) != 0;
     // The builder text says which packet widths this Embree traces natively
     // (an emulated width is split into single rays inside Embree).
-    stats_.builder = "embree-default-robust, packets 4/8/16 ";
+    stats_.builder = std::string(options.robust ? "robust" : "fast") + " mode, " +
+                     embree_quality_name(options.quality) + " quality, packets 4/8/16 ";
     for (int k = 0; k < 3; ++k) stats_.builder += std::string(k ? "/" : "") + (native_[k] ? "native" : "emulated");
     stats_.build_ms = std::chrono::duration<double, std::milli>(stop - start).count();
     const std::int64_t bytes = allocated_.load();
     stats_.bytes = bytes > 0 ? std::size_t(bytes) : 0;  // geometry buffers included
 }
 
-void EmbreeAccel::build(const Scene& scene) {
+void EmbreeAccel::build(const Scene& scene, const EmbreeOptions& options) {
     // The comparison is meaningless if this build of Embree culls back faces
     // (raypack's triangles are two-sided) or lacks a primitive type.
     if (rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_BACKFACE_CULLING_ENABLED) ||
@@ -322,8 +287,11 @@ void EmbreeAccel::build(const Scene& scene) {
         fail("this build lacks point or user geometry");
 
     scene_ = rtcNewScene(device_);
-    rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_ROBUST);
-    rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_MEDIUM);
+    // Fast mode is Embree's default and its best speed; robust mode avoids
+    // optimisations that can lose hits at shared edges (Embree API,
+    // rtcSetSceneFlags). Both are offered; neither is raypack's to choose.
+    rtcSetSceneFlags(scene_, options.robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
+    rtcSetSceneBuildQuality(scene_, options.quality);
 
     // Per-kind index -> global number, inverted from scene.prims.
     std::vector<std::uint32_t> sphere_global(scene.spheres.size()), tri_global(scene.triangles.size()),
@@ -337,7 +305,7 @@ void EmbreeAccel::build(const Scene& scene) {
         }
     }
     auto attach = [&](RTCGeometry geom, std::vector<std::uint32_t>&& globals) {
-        rtcSetGeometryBuildQuality(geom, RTC_BUILD_QUALITY_MEDIUM);
+        rtcSetGeometryBuildQuality(geom, options.quality);
         rtcCommitGeometry(geom);
         const unsigned id = rtcAttachGeometry(scene_, geom);
         rtcReleaseGeometry(geom);
@@ -406,6 +374,16 @@ void EmbreeAccel::build(const Scene& scene) {
 
     rtcCommitScene(scene_);
     if (rtcGetDeviceError(device_) != RTC_ERROR_NONE) fail("scene build failed");
+
+    // Where each geometry's primitives have consecutive global numbers (one
+    // kind of primitive, or kinds defined in runs), a hit's number is
+    // base + primID, computed for a whole packet at once.
+    consecutive_ = to_global_.size() <= base_.size();
+    for (std::size_t g = 0; g < to_global_.size() && consecutive_; ++g) {
+        base_[g] = to_global_[g].empty() ? 0 : to_global_[g][0];
+        for (std::size_t i = 0; i < to_global_[g].size() && consecutive_; ++i)
+            consecutive_ = to_global_[g][i] == base_[g] + std::uint32_t(i);
+    }
 }
 
 EmbreeAccel::~EmbreeAccel() {
@@ -413,9 +391,11 @@ EmbreeAccel::~EmbreeAccel() {
     if (device_) rtcReleaseDevice(device_);
 }
 
+// Embree 3 reads the coherent flag only in its packet and stream paths, so
+// single rays take the default context.
 void EmbreeAccel::intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const {
     const DenormalsOff ftz;
-    RTCIntersectContext context = context_for(rays);
+    RTCIntersectContext context = make_context(false);
     for (std::size_t i = 0; i < rays.size(); ++i) {
         RTCRayHit rh;
         rh.ray = to_embree(rays[i]);
@@ -436,7 +416,7 @@ void EmbreeAccel::intersect(std::span<const Rayf> rays, std::span<Hitf> hits) co
 
 void EmbreeAccel::occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const {
     const DenormalsOff ftz;
-    RTCIntersectContext context = context_for(rays);
+    RTCIntersectContext context = make_context(false);
     for (std::size_t i = 0; i < rays.size(); ++i) {
         RTCRay ray = to_embree(rays[i]);
         rtcOccluded1(scene_, &context, &ray);
@@ -455,51 +435,70 @@ bool EmbreeAccel::native_packet(int width) const {
     }
 }
 
+/// Whether a packet runs in the coherent context: its rays share one origin
+/// (camera rays; the property raypack's default configuration keys on),
+/// unless the options fix the context.
+bool EmbreeAccel::coherent(bool one_origin) const {
+    switch (options_.context) {
+        case EmbreeContext::Coherent: return true;
+        case EmbreeContext::Incoherent: return false;
+        default: return one_origin;
+    }
+}
+
 template <int K>
 void EmbreeAccel::intersect_k(std::span<const Rayf> rays, std::span<Hitf> hits) const {
     const DenormalsOff ftz;
-    RTCIntersectContext context = context_for(rays);
+    typename EmbreePacket<K>::RayHit rh;
+    embree_io::set_constant_fields<K>(rh.ray);
+    alignas(64) int valid[K];
+    for (int i = 0; i < K; ++i) valid[i] = -1;
     for (std::size_t first = 0; first < rays.size(); first += K) {
-        const std::size_t n = std::min<std::size_t>(K, rays.size() - first);
-        typename EmbreePacket<K>::RayHit rh;
-        alignas(64) int valid[K];
-        load_embree_packet<K>(rays.subspan(first, n), rh.ray, valid);
-        for (int i = 0; i < K; ++i) {
-            rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-            rh.hit.primID[i] = RTC_INVALID_GEOMETRY_ID;
-            rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
-        }
-        EmbreePacket<K>::intersect(valid, scene_, &context, &rh);
-        for (std::size_t i = 0; i < n; ++i) {
-            Hitf hit;
-            if (rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID) {
-                hit.t = rh.ray.tfar[i];
-                hit.prim = to_global_[rh.hit.geomID[i]][rh.hit.primID[i]];
-                hit.u = rh.hit.u[i];
-                hit.v = rh.hit.v[i];
+        const int n = int(std::min<std::size_t>(K, rays.size() - first));
+        bool one_origin;
+        if (n == K) {
+            one_origin = embree_io::load_full<K>(rays.data() + first, rh.ray);
+        } else {  // the last, partial packet: lanes past the end repeat the last ray, masked off
+            one_origin = false;
+            for (int i = 0; i < K; ++i) {
+                embree_io::set_lane(rh.ray, i, rays[first + std::size_t(std::min(i, n - 1))]);
+                valid[i] = i < n ? -1 : 0;
             }
-            hits[first + i] = hit;
         }
+        embree_io::clear_hits<K>(rh.hit);
+        RTCIntersectContext context = make_context(coherent(one_origin));
+        EmbreePacket<K>::intersect(valid, scene_, &context, &rh);
+        embree_io::store_hits<K>(rh, n, base_.data(), consecutive_, to_global_, hits.data() + first);
     }
 }
 
 template <int K>
 void EmbreeAccel::occluded_k(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const {
     const DenormalsOff ftz;
-    RTCIntersectContext context = context_for(rays);
+    typename EmbreePacket<K>::Ray ray;
+    embree_io::set_constant_fields<K>(ray);
+    alignas(64) int valid[K];
+    for (int i = 0; i < K; ++i) valid[i] = -1;
     for (std::size_t first = 0; first < rays.size(); first += K) {
-        const std::size_t n = std::min<std::size_t>(K, rays.size() - first);
-        typename EmbreePacket<K>::Ray ray;
-        alignas(64) int valid[K];
-        load_embree_packet<K>(rays.subspan(first, n), ray, valid);
+        const int n = int(std::min<std::size_t>(K, rays.size() - first));
+        bool one_origin;
+        if (n == K) {
+            one_origin = embree_io::load_full<K>(rays.data() + first, ray);
+        } else {
+            one_origin = false;
+            for (int i = 0; i < K; ++i) {
+                embree_io::set_lane(ray, i, rays[first + std::size_t(std::min(i, n - 1))]);
+                valid[i] = i < n ? -1 : 0;
+            }
+        }
+        RTCIntersectContext context = make_context(coherent(one_origin));
         EmbreePacket<K>::occluded(valid, scene_, &context, &ray);
-        for (std::size_t i = 0; i < n; ++i)
-            occluded[first + i] = ray.tfar[i] == -std::numeric_limits<float>::infinity() ? 1 : 0;
+        embree_io::store_occluded<K>(ray, n, occluded.data() + first);
     }
 }
 
-// Batches whose rays share one origin run in Embree's coherent context,
-// others in its default incoherent one (context_for above).
+// Packets whose rays share one origin run in Embree's coherent context,
+// others in its default incoherent one (coherent() above).
 void EmbreeAccel::intersect_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
     switch (width) {
         case 4: return intersect_k<4>(rays, hits);
