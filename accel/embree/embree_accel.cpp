@@ -1,8 +1,9 @@
 #include "accel/embree/embree_accel.h"
-#include "accel/embree/embree_packet_io.h"
-#include "accel/embree/embree_packet_types.h"
 
 #ifdef RAYPACK_HAVE_EMBREE
+
+#include "accel/embree/embree_packet_io.h"
+#include "accel/embree/embree_packet_types.h"
 
 #include <pmmintrin.h>
 #include <xmmintrin.h>
