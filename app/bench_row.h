@@ -1,6 +1,6 @@
 #pragma once
 // One measured case of `raypack bench`: the row of the table, the JSON array
-// and the CSV file (schema in README.md, "raypack bench").
+// and the CSV file (schema in docs/bench.md).
 #include <cstddef>
 #include <optional>
 #include <string>

@@ -2,7 +2,7 @@
 // raypack bench --tradeoff: for every variant of the triangle test, the
 // sphere test, the secondary-ray offset, the slab test, the reciprocal, the
 // precision of the primitive tests and the BVH builder, its throughput and
-// the errors it causes (README, "Speed against accuracy").
+// the errors it causes (docs/accuracy.md).
 #include <string>
 
 namespace raypack::app {

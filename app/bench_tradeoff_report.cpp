@@ -13,7 +13,7 @@ using Json = nlohmann::ordered_json;
 Json number_or_null(bool present, double v) { return present && std::isfinite(v) ? Json(v) : Json(); }
 
 /// One flat object per row; the same keys on every row (null where a
-/// measure does not apply), which is the CSV header too. Schema: README.
+/// measure does not apply), which is the CSV header too. Schema: docs/accuracy.md.
 Json to_json(const TradeoffRow& r) {
     Json j;
     j["family"] = r.family;

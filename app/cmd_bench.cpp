@@ -101,7 +101,7 @@ void print_help() {
         "  --threads LIST worker thread counts (default 1)\n"
         "  --repeat R     timed passes after one warm-up; median, min and max reported (default 5)\n"
         "  --res W H      image size of the generated ray sets (default 512 512)\n"
-        "  --json FILE    one object per row; --csv FILE: the same columns (schema: README)\n"
+        "  --json FILE    one object per row; --csv FILE: the same columns (schema: docs/bench.md)\n"
         "  --quick        every structure (brute too), width and ray kind on gen:balls:3 at 256x256,\n"
         "                 repeat 3: the CI smoke run; explicit options still apply\n"
         "  --offset P     secondary-ray origins of the shadow and diffuse sets: %s (default %s)\n"
@@ -112,7 +112,7 @@ void print_help() {
         "  --tradeoff     speed against accuracy of each triangle, sphere, slab, rcp, precision, builder\n"
         "                 and offset variant: throughput, leaks at shared edges and vertices, t error\n"
         "                 in ULPs, self-intersections from scale 1e-4 to 1e6, image error against a\n"
-        "                 double reference (README)\n",
+        "                 double reference (docs/accuracy.md)\n",
         accel_kinds_list().c_str(), offset_policy_list().c_str(), offset_policy_name(kDefaultOffset),
         bvh_builder_list().c_str(), kernel_options_help().c_str());
 }

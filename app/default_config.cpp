@@ -26,8 +26,9 @@ RayWorkload classify_workload(std::span<const Rayf> rays, bool any_hit) {
 }
 
 TraceConfig fastest_config(RayWorkload workload) {
-    // From the README's table (one thread, 1024 x 1024, geometric mean over
-    // balls, mount, tetra, teapot and the bunny, median of three runs): wide
+    // From the structure table of README.md at e7139a3, "Against Embree on
+    // the same rays" (one thread, 1024 x 1024, geometric mean over balls,
+    // mount, tetra, teapot and the bunny, median of three runs): wide
     // BVHs with packets of 16 for every kind; BVH4 and BVH8 are within 2-8% of
     // each other throughout, and the packets' single-ray fallback (Benthin et
     // al. 2012) keeps them ahead of one-ray-at-a-time on diffuse rays too.

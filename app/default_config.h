@@ -1,7 +1,7 @@
 #pragma once
 // The configuration trace and render use when the command line names no
 // structure, builder or packet width: the fastest one for the kind of rays,
-// as measured in the README's table "Against Embree on the same rays".
+// as measured (app/default_config.cpp says where).
 #include <span>
 #include <string>
 

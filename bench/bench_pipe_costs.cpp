@@ -6,7 +6,7 @@
 // alternately inside each benchmark iteration, so the reported ratio comes
 // from one run on a shared machine:
 //   fma_cycles = (time with the N copies / time without - 1) x 8 / N,
-// in units of one zmm FMA. README, "Speed-ups over width 1", uses these to
+// in units of one zmm FMA. docs/kernels.md, "Speed-ups over width 1", uses these to
 // bound the width-16 triangle kernel. AVX-512 (F, DQ, VL) builds only.
 #include <benchmark/benchmark.h>
 

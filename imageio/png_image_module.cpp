@@ -42,7 +42,7 @@ void on_png_error(png_structp png, png_const_charp message) {
 
 /// Writes 8-bit RGB rows. zlib level 1 with the Sub filter: on the seven SPD
 /// renders (512 x 512) it wrote 2-4x faster than libpng's defaults (which
-/// OpenImageIO used) for files 5-33% larger (README "Build options").
+/// OpenImageIO used) for files 5-33% larger (docs/build.md).
 bool write_png(std::FILE* file, int width, int height, const unsigned char* bytes, char* message) {
     png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, message, on_png_error, nullptr);
     if (!png) return false;

@@ -76,7 +76,7 @@ template <class F> using mask_of = typename LaneTraits<F>::Mask;
 template <class F> inline constexpr int lanes_of = LaneTraits<F>::width;
 /// True when F's masks live in AVX-512 mask registers (width 16). On Zen 4
 /// every instruction that writes one (a compare) takes a cycle of the FMA
-/// pipes, as a zmm multiply does (README, "Speed-ups over width 1").
+/// pipes, as a zmm multiply does (docs/kernels.md, "Speed-ups over width 1").
 template <class F> inline constexpr bool kMaskRegisters = lanes_of<F> == 16;
 
 // ---- Width-generic operations ---------------------------------------------

@@ -1,6 +1,6 @@
 #pragma once
 // The errors a speed-for-accuracy choice causes, each counted against a
-// definition that admits no excuse (README, "Speed against accuracy"):
+// definition that admits no excuse (docs/accuracy.md):
 // leaks through closed meshes and spheres, t error in ULPs against a double
 // reference, self-intersections of secondary rays, image error against a
 // double-precision reference render.

@@ -2,7 +2,7 @@
 // Where a secondary ray starts: the hit point moved off the surface so that
 // the new ray does not find the surface it left (self-intersection, "surface
 // acne"). Three policies, selectable with --offset, compared by
-// `raypack bench --tradeoff` (README, "Speed against accuracy").
+// `raypack bench --tradeoff` (docs/accuracy.md).
 #include <limits>
 #include <optional>
 #include <string>

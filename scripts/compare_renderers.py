@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Whole-process render times of raypack, POV-Ray 3.7 and Tachyon on the SPD
 scenes, alternating the three programs round by round; prints medians and
-ratios as a Markdown table (README, "Against POV-Ray and Tachyon").
+ratios as a Markdown table (docs/renderer.md, "Whole-process time against POV-Ray 3.7 and Tachyon").
 
 usage: scripts/compare_renderers.py [--rounds N] [--threads T] [--res N]
                                     [--raypack BUILD/raypack] [SCENE ...]

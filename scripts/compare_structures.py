@@ -6,7 +6,7 @@ structure and packet width, each validated against the oracle, median of
 REPEAT timed passes after a warm-up), printed as a Markdown table of Mrays/s
 and ratios to the first structure listed (the BVH2 by default) at the same
 width; "-" where a structure has no packets of that width. This is how the
-README's structure table is made.
+structure table of docs/structures.md is made.
 
 usage: scripts/compare_structures.py [--res 1024] [--repeat 5] [SCENE ...]
 """

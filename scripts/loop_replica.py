@@ -17,7 +17,7 @@ leave a value to be carried from one iteration to the next, or the copy
 measures a dependency chain instead (removing blends or compares is safe,
 removing an FMA usually is not).
 
-Example (README, "Speed-ups over width 1"):
+Example (docs/kernels.md, "Speed-ups over width 1"):
   scripts/loop_replica.py build/bench/raypack_bench \\
       'triangle_packet<(raypack::TriangleMethod)0, 16>' --contains vdivps \\
       --drop '\\{%k1\\}$'

@@ -139,8 +139,7 @@ TEST(Cli, TraceAnswersClosestAndAnyHitWithJson) {
 }
 
 /// With no structure, builder or width named, trace runs the fastest measured
-/// configuration for the kind of rays (app/default_config.cpp, the README's
-/// table) and says so in --json; naming any of them turns that off.
+/// configuration for the kind of rays (app/default_config.cpp) and says so in --json; naming any of them turns that off.
 TEST(Cli, TraceDefaultsToTheFastestConfigurationForTheRays) {
     const fs::path dir = temp_dir();
     const std::string scene = "gen:balls:2";
