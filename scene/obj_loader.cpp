@@ -152,14 +152,17 @@ void frame(Scene& scene) {
 }  // namespace
 
 void append_obj_triangles(const std::string& path, std::uint32_t material, Scene& scene) {
-    const std::string text = read_scene_file(path);
+    append_obj_text(read_scene_file(path), path, material, scene);
+}
+
+void append_obj_text(std::string_view text, const std::string& path, std::uint32_t material, Scene& scene) {
     const std::vector<int> face_lines = prescan(text, path);
 
     tinyobj::attrib_t attrib;
     std::vector<tinyobj::shape_t> shapes;
     std::vector<tinyobj::material_t> materials;
     std::string warn, err;
-    std::istringstream in(text);
+    std::istringstream in{std::string(text)};
     // No material reader: "mtllib" is skipped. Faces are triangulated here,
     // with the same triangulation as NFF polygons.
     const bool ok = tinyobj::LoadObj(&attrib, &shapes, &materials, &warn, &err, &in, nullptr,
@@ -217,17 +220,19 @@ void append_obj_triangles(const std::string& path, std::uint32_t material, Scene
     if (scene.triangles.size() == triangles_before) throw SceneError(path, 0, "no faces");
 }
 
-Scene load_obj_file(const std::string& path) {
+Scene load_obj_text(std::string_view text, const std::string& name) {
     Scene scene;
-    scene.source = path;
+    scene.source = name;
     Material grey;
     grey.color = {0.8f, 0.8f, 0.8f};
     grey.kd = 0.8f;
     scene.materials.push_back(grey);
-    append_obj_triangles(path, 0, scene);
+    append_obj_text(text, name, 0, scene);
     frame(scene);
     scene.update_features();
     return scene;
 }
+
+Scene load_obj_file(const std::string& path) { return load_obj_text(read_scene_file(path), path); }
 
 }  // namespace raypack

@@ -23,64 +23,98 @@ constexpr std::size_t kRayRecord = 32, kHitRecord = 16;
     throw std::runtime_error(path + ": " + what);
 }
 
-std::ifstream open_checked(const std::string& path, const char (&magic)[8], std::uint64_t& count,
-                           std::size_t header, std::size_t record) {
+/// The record count of a file of `size` bytes whose first bytes are `head`
+/// (at least the magic and the count if the file has them), checked against
+/// the magic and the size.
+std::uint64_t checked_count(std::string_view head, std::uint64_t size, const std::string& name,
+                            const char (&magic)[8], std::size_t header, std::size_t record) {
+    if (head.size() < 8 || std::memcmp(head.data(), magic, 8) != 0)
+        fail(name, std::string("not a ") + (magic[0] == 'R' ? ".rays" : ".hits") + " file (bad magic)");
+    if (head.size() < 16) fail(name, "truncated header");
+    std::uint64_t count = 0;
+    std::memcpy(&count, head.data() + 8, 8);
+    if (size < header || count > (size - header) / record)
+        fail(name, "truncated: header says " + std::to_string(count) + " records");
+    if (size != header + count * record) fail(name, "size does not match the record count");
+    return count;
+}
+
+/// A whole file, after its header was checked by `check` (given the file's
+/// first bytes and its size), so that an absurd header is refused before
+/// anything large is read.
+template <class Check>
+std::string read_checked(const std::string& path, Check&& check) {
     std::ifstream in(path, std::ios::binary);
     if (!in) fail(path, "cannot open for reading");
-    char m[8];
-    if (!in.read(m, 8) || std::memcmp(m, magic, 8) != 0)
-        fail(path, std::string("not a ") + (magic[0] == 'R' ? ".rays" : ".hits") + " file (bad magic)");
-    if (!in.read(reinterpret_cast<char*>(&count), 8)) fail(path, "truncated header");
-    const auto size = std::filesystem::file_size(path);
-    if (size < header || count > (size - header) / record) fail(path, "truncated: header says " + std::to_string(count) + " records");
-    if (size != header + count * record) fail(path, "size does not match the record count");
-    return in;
+    std::error_code ec;
+    const std::uint64_t size = std::filesystem::file_size(path, ec);
+    if (ec) fail(path, "cannot open for reading");
+    char head[24];
+    in.read(head, sizeof head);
+    check(std::string_view(head, std::size_t(in.gcount())), size);
+    std::string bytes(std::size_t(size), '\0');
+    in.clear();
+    in.seekg(0);
+    if (!in.read(bytes.data(), std::streamsize(size))) fail(path, "truncated records");
+    return bytes;
 }
 
 }  // namespace
 
-RayFile read_rays(const std::string& path) {
-    std::uint64_t count = 0;
-    std::ifstream in = open_checked(path, kRaysMagic, count, 24, kRayRecord);
-    std::uint32_t kind = 0, reserved = 0;
-    in.read(reinterpret_cast<char*>(&kind), 4);
-    in.read(reinterpret_cast<char*>(&reserved), 4);
-    if (kind > 1) fail(path, "unknown ray kind " + std::to_string(kind) + " (expected 0 or 1)");
-    // The rays and the read buffer, 32 bytes each per ray.
-    require_memory(count * 64, path + ": " + std::to_string(count) + " rays");
+RayFile parse_rays(std::string_view bytes, const std::string& name) {
+    const std::uint64_t count = checked_count(bytes, bytes.size(), name, kRaysMagic, 24, kRayRecord);
+    std::uint32_t kind = 0;
+    std::memcpy(&kind, bytes.data() + 16, 4);
+    if (kind > 1) fail(name, "unknown ray kind " + std::to_string(kind) + " (expected 0 or 1)");
+    require_memory(count * sizeof(Rayf), name + ": " + std::to_string(count) + " rays");
     RayFile file;
     file.kind = RayKind(kind);
     file.rays.resize(count);
-    std::vector<float> buf(8 * count);
-    if (!in.read(reinterpret_cast<char*>(buf.data()), std::streamsize(buf.size() * 4))) fail(path, "truncated records");
-    for (std::uint64_t i = 0; i < count; ++i) {
-        const float* r = &buf[8 * i];
+    const char* rec = bytes.data() + 24;
+    for (std::uint64_t i = 0; i < count; ++i, rec += kRayRecord) {
+        float r[8];
+        std::memcpy(r, rec, sizeof r);
         Rayf& ray = file.rays[i];
         ray.org = {r[0], r[1], r[2]};
         ray.tnear = r[3];
         ray.dir = {r[4], r[5], r[6]};
         ray.tfar = r[7];
         if (!all_finite(ray.org) || !all_finite(ray.dir) || std::isnan(ray.tnear) || std::isnan(ray.tfar))
-            fail(path, "ray " + std::to_string(i) + " has a non-finite origin, direction or NaN interval");
+            fail(name, "ray " + std::to_string(i) + " has a non-finite origin, direction or NaN interval");
     }
     return file;
 }
 
-std::vector<Hitf> read_hits(const std::string& path) {
-    std::uint64_t count = 0;
-    std::ifstream in = open_checked(path, kHitsMagic, count, 16, kHitRecord);
-    require_memory(count * sizeof(Hitf), path + ": " + std::to_string(count) + " hits");
+std::vector<Hitf> parse_hits(std::string_view bytes, const std::string& name) {
+    const std::uint64_t count = checked_count(bytes, bytes.size(), name, kHitsMagic, 16, kHitRecord);
+    require_memory(count * sizeof(Hitf), name + ": " + std::to_string(count) + " hits");
     std::vector<Hitf> hits(count);
+    const char* rec = bytes.data() + 16;
     for (auto& h : hits) {
-        char rec[16];
-        in.read(rec, 16);
         std::memcpy(&h.t, rec, 4);
         std::memcpy(&h.prim, rec + 4, 4);
         std::memcpy(&h.u, rec + 8, 4);
         std::memcpy(&h.v, rec + 12, 4);
+        rec += kHitRecord;
     }
-    if (!in) fail(path, "truncated records");
     return hits;
+}
+
+RayFile read_rays(const std::string& path) {
+    // The file's bytes and the rays, 32 bytes each per ray.
+    const std::string bytes = read_checked(path, [&](std::string_view head, std::uint64_t size) {
+        const std::uint64_t count = checked_count(head, size, path, kRaysMagic, 24, kRayRecord);
+        require_memory(count * 64, path + ": " + std::to_string(count) + " rays");
+    });
+    return parse_rays(bytes, path);
+}
+
+std::vector<Hitf> read_hits(const std::string& path) {
+    const std::string bytes = read_checked(path, [&](std::string_view head, std::uint64_t size) {
+        const std::uint64_t count = checked_count(head, size, path, kHitsMagic, 16, kHitRecord);
+        require_memory(count * (kHitRecord + sizeof(Hitf)), path + ": " + std::to_string(count) + " hits");
+    });
+    return parse_hits(bytes, path);
 }
 
 void write_rays(const std::string& path, RayKind kind, std::span<const Rayf> rays) {

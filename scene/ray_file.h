@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "kernels/ray.h"
@@ -21,6 +22,10 @@ struct RayFile {
 /// truncated, unknown kind, non-finite origin or direction, absurd count).
 RayFile read_rays(const std::string& path);
 std::vector<Hitf> read_hits(const std::string& path);
+/// The same readers on a file's bytes already in memory; `name` is the
+/// file the errors name.
+RayFile parse_rays(std::string_view bytes, const std::string& name);
+std::vector<Hitf> parse_hits(std::string_view bytes, const std::string& name);
 
 /// Both write to a temporary file beside `path` and rename it into place, so
 /// an existing file is never left half-written.

@@ -241,6 +241,36 @@ TEST_F(RayFile, NonFiniteRayRejected) {
     EXPECT_EQ(read_rays(path("ok.rays")).rays.size(), rays.size());
 }
 
+// The fuzz targets read bytes in memory (fuzz/rays_fuzzer.cpp): the same
+// answers and the same errors as the file readers, naming the given name.
+TEST_F(RayFile, BytesInMemoryReadAsTheFile) {
+    const std::vector<Rayf> rays = sample_rays();
+    write_rays(path("m.rays"), RayKind::AnyHit, rays);
+    const std::string bytes = slurp(path("m.rays"));
+    const raypack::RayFile from_file = read_rays(path("m.rays"));
+    const raypack::RayFile from_bytes = raypack::parse_rays(bytes, "memory.rays");
+    EXPECT_EQ(from_bytes.kind, RayKind::AnyHit);
+    ASSERT_EQ(from_bytes.rays.size(), from_file.rays.size());
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        EXPECT_TRUE(same_bits(from_bytes.rays[i].org.x, from_file.rays[i].org.x)) << i;
+        EXPECT_TRUE(same_bits(from_bytes.rays[i].dir.z, from_file.rays[i].dir.z)) << i;
+        EXPECT_TRUE(same_bits(from_bytes.rays[i].tfar, from_file.rays[i].tfar)) << i;
+    }
+    expect_error([&] { raypack::parse_rays(bytes.substr(0, bytes.size() - 1), "memory.rays"); }, "memory.rays",
+                 "truncated");
+    expect_error([&] { raypack::parse_rays(bytes.substr(0, 5), "memory.rays"); }, "memory.rays", "bad magic");
+    expect_error([&] { raypack::parse_hits(bytes, "memory.hits"); }, "memory.hits", "bad magic");
+
+    std::vector<Hitf> hits(3);
+    hits[1] = Hitf{2.5f, 7, 0.25f, 0.5f};
+    write_hits(path("m.hits"), hits);
+    const std::vector<Hitf> back = raypack::parse_hits(slurp(path("m.hits")), "memory.hits");
+    ASSERT_EQ(back.size(), 3u);
+    EXPECT_EQ(back[1].prim, 7u);
+    EXPECT_EQ(back[1].v, 0.5f);
+    EXPECT_FALSE(back[0].found());
+}
+
 TEST_F(RayFile, UnknownKindRejected) {
     write_rays(path("a.rays"), RayKind::AnyHit, sample_rays());
     std::string bytes = slurp(path("a.rays"));
