@@ -5,6 +5,7 @@
 #include <string>
 
 #include "app/commands.h"
+#include "app/heap_pages.h"
 
 namespace {
 
@@ -28,6 +29,7 @@ void print_usage(std::FILE* out) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    raypack::app::reserve_heap_in_large_pages();
     if (argc < 2) {
         print_usage(stderr);
         return 2;
