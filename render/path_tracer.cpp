@@ -72,9 +72,16 @@ struct Shadows {
     }
 };
 
+/// A camera sample: its pixel's number and its index in the pixel (the
+/// sampler's key, kept apart so that no draw divides to split them).
+struct SampleKey {
+    std::uint64_t pixel;
+    int index;
+};
+
 struct Scratch {
     std::vector<PixelXY> pixels;
-    std::vector<std::uint64_t> keys;  ///< pixel * spp + index, per sample of the tile
+    std::vector<SampleKey> keys;      ///< per sample of the tile
     std::vector<Vec3f> radiance;      ///< per sample of the tile
     Paths paths, next;
     Shadows shadows;
@@ -120,17 +127,14 @@ private:
 
     /// The unit-square point of dimension `dim` of sample `key`: each bounce
     /// uses its own dimensions (light choice, light point, lobe, roulette).
-    Sample2 get(std::uint64_t key, int dim) const {
-        const auto spp = std::uint64_t(samples_.spp());
-        return samples_.get(key / spp, int(key % spp), dim);
-    }
+    Sample2 get(const SampleKey& key, int dim) const { return samples_.get(key.pixel, key.index, dim); }
 
     void bounce(std::size_t i, int depth, Scratch& s) const {
         const Paths& p = s.paths;
         const Rayf ray = p.rays[i];
         const Hitf hit = p.hits[i];
         const std::uint32_t si = p.sample[i];
-        const std::uint64_t key = s.keys[si];
+        const SampleKey key = s.keys[si];
         const Vec3f beta = p.throughput[i];
         Vec3f& L = s.radiance[si];
         if (!hit.found()) {
@@ -250,7 +254,7 @@ private:
     /// One shadow ray to one light chosen uniformly among all of them
     /// (point, distant, area), weighted by their number.
     void direct_light(std::uint32_t si, const Vec3f& above, const Vec3f& ns, const Vec3f& ng, const Vec3f& beta,
-                      const Vec3f& f, std::uint64_t key, int dim, Scratch& s) const {
+                      const Vec3f& f, const SampleKey& key, int dim, Scratch& s) const {
         const std::size_t n_point = scene_.lights.size(), n_distant = scene_.distant_lights.size();
         const std::size_t n = n_point + n_distant + scene_.area_lights.size();
         if (n == 0) return;
@@ -336,7 +340,7 @@ RenderStats render_path(const Scene& scene, const Accel& accel, const WhittedOpt
                     Rayf r;
                     sampled_camera_ray(frame, scene.camera, tracer.samples(), options.filter, pixel, px.x, px.y, k, r);
                     s.paths.add(r, {1, 1, 1}, std::uint32_t(s.keys.size()), true);
-                    s.keys.push_back(pixel * std::uint64_t(spp) + std::uint64_t(k));
+                    s.keys.push_back({pixel, k});
                 }
             }
             tracer.trace(s);

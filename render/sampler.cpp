@@ -137,7 +137,10 @@ Sampler::Sampler(SamplerKind kind, int spp, std::uint64_t seed)
       inv_nx_(1.0 / grid_.nx),
       inv_ny_(1.0 / grid_.ny),
       log2_nx_(std::has_single_bit(unsigned(grid_.nx)) ? std::countr_zero(unsigned(grid_.nx)) : -1),
-      log2_ny_(std::has_single_bit(unsigned(grid_.ny)) ? std::countr_zero(unsigned(grid_.ny)) : -1) {}
+      log2_ny_(std::has_single_bit(unsigned(grid_.ny)) ? std::countr_zero(unsigned(grid_.ny)) : -1),
+      // Computed once: ldexp per sample was 5% of a path-traced bunny.
+      jitter_unit_x_(std::ldexp(1.0f, log2_nx_ - 24)),
+      jitter_unit_y_(std::ldexp(1.0f, log2_ny_ - 24)) {}
 
 Sample2 Sampler::get(std::uint64_t pixel, int index, int dimension) const {
     const auto n = std::uint32_t(spp_), i = std::uint32_t(index);
@@ -168,8 +171,8 @@ Sample2 Sampler::get(std::uint64_t pixel, int index, int dimension) const {
                 // point stays in its stratum with no check (the common spp 1,
                 // 4, 16, 64, 256 ...).
                 const std::uint32_t cx = cell & (nx - 1), cy = cell >> log2_nx_;
-                const float jx = float(std::uint32_t(jitter) >> (8 + log2_nx_)) * std::ldexp(1.0f, log2_nx_ - 24);
-                const float jy = float(std::uint32_t(jitter >> 32) >> (8 + log2_ny_)) * std::ldexp(1.0f, log2_ny_ - 24);
+                const float jx = float(std::uint32_t(jitter) >> (8 + log2_nx_)) * jitter_unit_x_;
+                const float jy = float(std::uint32_t(jitter >> 32) >> (8 + log2_ny_)) * jitter_unit_y_;
                 return {(float(cx) + jx) * float(inv_nx_), (float(cy) + jy) * float(inv_ny_)};
             }
             const std::uint32_t cy = cell / nx, cx = cell - cy * nx;

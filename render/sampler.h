@@ -52,6 +52,7 @@ private:
     StrataGrid grid_;
     double inv_nx_, inv_ny_;
     int log2_nx_, log2_ny_;  ///< -1 unless the grid side is a power of two
+    float jitter_unit_x_, jitter_unit_y_;  ///< 2^(log2 - 24): one step of a power-of-two stratum's jitter
 };
 
 }  // namespace raypack

@@ -33,8 +33,11 @@ inline Rayf thin_lens_ray(const CameraFrame& f, float px, float py, Sample2 lens
 inline void sampled_camera_ray(const CameraFrame& f, const Camera& camera, const Sampler& sampler, PixelFilter filter,
                                std::uint64_t pixel, int x, int y, int index, Rayf& out) {
     const Sample2 off = filter_offset(filter, sampler.get(pixel, index, 0));
-    out = thin_lens_ray(f, float(x) + 0.5f + off.x, float(y) + 0.5f + off.y, sampler.get(pixel, index, 1),
-                        camera.lens_radius, camera.focus_distance);
+    // A pinhole needs no lens point (the sampler is stateless: skipping the
+    // draw changes no other sample).
+    const Sample2 lens = camera.lens_radius > 0 ? sampler.get(pixel, index, 1) : Sample2{};
+    out = thin_lens_ray(f, float(x) + 0.5f + off.x, float(y) + 0.5f + off.y, lens, camera.lens_radius,
+                        camera.focus_distance);
 }
 
 }  // namespace raypack
