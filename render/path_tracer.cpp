@@ -72,10 +72,10 @@ struct Shadows {
     }
 };
 
-/// A camera sample: its pixel's number and its index in the pixel (the
-/// sampler's key, kept apart so that no draw divides to split them).
+/// A camera sample: its pixel (with the pixel's part of the sampler's hash,
+/// computed once) and its index in the pixel.
 struct SampleKey {
-    std::uint64_t pixel;
+    Sampler::Pixel pixel;
     int index;
 };
 
@@ -335,7 +335,8 @@ RenderStats render_path(const Scene& scene, const Accel& accel, const WhittedOpt
             s.keys.clear();
             s.radiance.assign(s.pixels.size() * std::size_t(k1 - k0), Vec3f{});
             for (const PixelXY& px : s.pixels) {
-                const std::uint64_t pixel = std::uint64_t(px.y) * std::uint64_t(options.width) + std::uint64_t(px.x);
+                const Sampler::Pixel pixel =
+                    tracer.samples().pixel(std::uint64_t(px.y) * std::uint64_t(options.width) + std::uint64_t(px.x));
                 for (int k = k0; k < k1; ++k) {
                     Rayf r;
                     sampled_camera_ray(frame, scene.camera, tracer.samples(), options.filter, pixel, px.x, px.y, k, r);

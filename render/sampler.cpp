@@ -15,10 +15,10 @@ std::uint64_t mix(std::uint64_t h) {
     return h ^ (h >> 31);
 }
 
-/// `seed_hash` is mix(seed + golden ratio), computed once per sampler.
-std::uint64_t hash_keys(std::uint64_t seed_hash, std::uint64_t pixel, std::uint64_t dimension, std::uint64_t purpose) {
-    const std::uint64_t h = mix(seed_hash ^ (pixel + 0x9E3779B97F4A7C15ull * 2));
-    return mix(h ^ (dimension * 0x100000001B3ull + purpose + 1));
+/// The seed of one (pixel, dimension, purpose), from the pixel's hash
+/// (Sampler::pixel: the seed's hash mixed with the pixel number).
+std::uint64_t hash_keys(std::uint64_t pixel_hash, std::uint64_t dimension, std::uint64_t purpose) {
+    return mix(pixel_hash ^ (dimension * 0x100000001B3ull + purpose + 1));
 }
 
 /// [0, 1) from the top 24 bits, so that the float never rounds up to 1.
@@ -142,7 +142,11 @@ Sampler::Sampler(SamplerKind kind, int spp, std::uint64_t seed)
       jitter_unit_x_(std::ldexp(1.0f, log2_nx_ - 24)),
       jitter_unit_y_(std::ldexp(1.0f, log2_ny_ - 24)) {}
 
-Sample2 Sampler::get(std::uint64_t pixel, int index, int dimension) const {
+Sampler::Pixel Sampler::pixel(std::uint64_t number) const {
+    return {number, mix(seed_hash_ ^ (number + 0x9E3779B97F4A7C15ull * 2))};
+}
+
+Sample2 Sampler::get(const Pixel& pixel, int index, int dimension) const {
     const auto n = std::uint32_t(spp_), i = std::uint32_t(index);
     switch (kind_) {
         case SamplerKind::Regular: {
@@ -154,13 +158,13 @@ Sample2 Sampler::get(std::uint64_t pixel, int index, int dimension) const {
                     (float(cell / std::uint32_t(grid_.nx)) + 0.5f) / float(grid_.ny)};
         }
         case SamplerKind::Random: {
-            const std::uint64_t h = hash_keys(seed_hash_, pixel, std::uint64_t(dimension), 1 + std::uint64_t(i) * 4);
+            const std::uint64_t h = hash_keys(pixel.hash, std::uint64_t(dimension), 1 + std::uint64_t(i) * 4);
             return {unit_float(std::uint32_t(h)), unit_float(std::uint32_t(h >> 32))};
         }
         case SamplerKind::Stratified: {
             // Cells shuffled per pixel and dimension (pbrt's stratified
             // sampler shuffles too), so that dimensions are not correlated.
-            const std::uint64_t key = hash_keys(seed_hash_, pixel, std::uint64_t(dimension), 0);
+            const std::uint64_t key = hash_keys(pixel.hash, std::uint64_t(dimension), 0);
             const std::uint32_t cell = permute(i, n, std::uint32_t(key));
             // The jitter of sample i: one more mix of the (pixel, dimension) key.
             const std::uint64_t jitter = mix(key + 0x9E3779B97F4A7C15ull * (std::uint64_t(i) + 1));
@@ -182,7 +186,7 @@ Sample2 Sampler::get(std::uint64_t pixel, int index, int dimension) const {
             // Burley (2020): shuffle the index by an Owen scramble (which keeps
             // it inside one aligned block of 2^m points, a (0, m, 2)-net), then
             // Owen-scramble each coordinate; seeds per pixel and dimension.
-            const std::uint64_t k1 = hash_keys(seed_hash_, pixel, std::uint64_t(dimension), 0);
+            const std::uint64_t k1 = hash_keys(pixel.hash, std::uint64_t(dimension), 0);
             const std::uint64_t k2 = mix(k1 + 0x9E3779B97F4A7C15ull);
             const std::uint32_t shuffled = owen_scramble(i, std::uint32_t(k1));
             return {unit_float(owen_scramble(sobol0(shuffled), std::uint32_t(k1 >> 32))),

@@ -39,7 +39,16 @@ class Sampler {
 public:
     Sampler(SamplerKind kind, int spp, std::uint64_t seed);
 
-    Sample2 get(std::uint64_t pixel, int index, int dimension) const;
+    /// A pixel with the part of every draw's hash that depends on the pixel
+    /// alone, for callers that draw many samples of one pixel.
+    struct Pixel {
+        std::uint64_t number;
+        std::uint64_t hash;
+    };
+    Pixel pixel(std::uint64_t number) const;
+
+    Sample2 get(const Pixel& pixel, int index, int dimension) const;
+    Sample2 get(std::uint64_t pixel, int index, int dimension) const { return get(this->pixel(pixel), index, dimension); }
 
     SamplerKind kind() const { return kind_; }
     int spp() const { return spp_; }

@@ -31,7 +31,7 @@ inline Rayf thin_lens_ray(const CameraFrame& f, float px, float py, Sample2 lens
 /// integrators: its position drawn from the pixel filter (sampler dimension
 /// 0), its lens point from dimension 1.
 inline void sampled_camera_ray(const CameraFrame& f, const Camera& camera, const Sampler& sampler, PixelFilter filter,
-                               std::uint64_t pixel, int x, int y, int index, Rayf& out) {
+                               const Sampler::Pixel& pixel, int x, int y, int index, Rayf& out) {
     const Sample2 off = filter_offset(filter, sampler.get(pixel, index, 0));
     // A pinhole needs no lens point (the sampler is stateless: skipping the
     // draw changes no other sample).

@@ -141,7 +141,7 @@ public:
             return;
         }
         const std::uint64_t pixel = std::uint64_t(y) * std::uint64_t(options_.width) + std::uint64_t(x);
-        sampled_camera_ray(frame, scene_.camera, samples_, options_.filter, pixel, x, y, index, ray);
+        sampled_camera_ray(frame, scene_.camera, samples_, options_.filter, samples_.pixel(pixel), x, y, index, ray);
     }
 
     /// The lens point of the sample with key `key` (sampler dimension 1).
