@@ -20,7 +20,8 @@ int run_rays(const Args& args) {
             "usage: raypack rays SCENE --kind camera|shadow|diffuse [--res W H] [--seed S] [--offset POLICY]\n"
             "                   -o FILE.rays\n"
             "  camera   one closest-hit ray through each pixel centre (kind 0)\n"
-            "  shadow   any-hit rays from each camera hit to the first light (kind 1)\n"
+            "  shadow   any-hit rays from each camera hit to the first light (kind 1): a point light,\n"
+            "           else a distant one, else an area light's centre (a sphere's facing point)\n"
             "  diffuse  a cosine-weighted bounce from each camera hit (kind 0); --seed S (default 1)\n"
             "%s",
             offset_option_help().c_str());

@@ -6,6 +6,8 @@
 
 #include "accel/accel.h"
 #include "render/camera_rays.h"
+#include "render/light_sampling.h"
+#include "render/ray_offset.h"
 #include "render/sampling.h"
 #include "render/surface.h"
 
@@ -43,20 +45,28 @@ std::vector<Rayf> camera_ray_set(const Scene& scene, int width, int height) {
 }
 
 std::vector<Rayf> shadow_ray_set(const Scene& scene, int width, int height, OffsetPolicy policy) {
-    if (scene.lights.empty()) return {};
+    // The first light: a point light, else a distant one, else an area light.
+    const bool point = !scene.lights.empty(), distant = !point && !scene.distant_lights.empty();
+    if (!point && !distant && scene.area_lights.empty()) return {};
     const std::vector<Rayf> camera = camera_ray_set(scene, width, height);
     const std::vector<Hitf> hits = camera_hits(scene, camera);
-    const Vec3f light = scene.lights.front().position;
     const RayOffset offset(policy, scene);
     std::vector<Rayf> rays;
     for (std::size_t i = 0; i < camera.size(); ++i) {
         if (!hits[i].found()) continue;
-        Rayf r;
-        r.org = offset_origin(scene, offset, camera[i], hits[i], surface_at(scene, camera[i], hits[i]));
-        r.dir = light - r.org;
-        r.tnear = offset.tnear();
-        r.tfar = 1.0f - 1e-6f;
-        rays.push_back(r);
+        const Vec3f org = offset_origin(scene, offset, camera[i], hits[i], surface_at(scene, camera[i], hits[i]));
+        Rayf& r = rays.emplace_back();
+        if (point) {
+            spawn_ray_to(org, scene.lights.front().position, offset, r);
+        } else if (distant) {
+            spawn_ray(org, -scene.distant_lights.front().direction, offset, r);
+        } else {
+            // Whitted's area-light sample: a parallelogram's centre, a
+            // sphere's point facing the surface (render/light_sampling.h).
+            const AreaLight& l = scene.area_lights.front();
+            const Sample2 u = l.shape == AreaLightShape::Sphere ? Sample2{0.0f, 0.0f} : Sample2{0.5f, 0.5f};
+            spawn_ray_to(org, sample_area_light(l, org, u).point, offset, r);
+        }
     }
     return rays;
 }

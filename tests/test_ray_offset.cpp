@@ -6,6 +6,7 @@
 
 #include <bit>
 #include <cmath>
+#include <limits>
 
 #include "accel/accel.h"
 #include "measure/accuracy_measures.h"
@@ -143,6 +144,36 @@ TEST(RayOffset, ShadowRaySetFollowsThePolicy) {
         differ += !(scaled[i].org == robust[i].org);
     }
     EXPECT_GT(differ, robust.size() / 2);
+}
+
+// Scenes without a point light: the shadow set aims at the first distant
+// light, else at the first area light (a parallelogram's centre), as
+// `raypack rays --kind shadow` documents.
+TEST(RayOffset, ShadowRaySetWithoutPointLights) {
+    Scene cornell = load_scene("gen:cornell:1");
+    ASSERT_TRUE(cornell.lights.empty());
+    ASSERT_TRUE(cornell.distant_lights.empty());
+    ASSERT_FALSE(cornell.area_lights.empty());
+    const AreaLight& l = cornell.area_lights.front();
+    ASSERT_EQ(l.shape, AreaLightShape::Parallelogram);
+    const Vec3f centre = l.corner + l.edge1 * 0.5f + l.edge2 * 0.5f;
+    const std::vector<Rayf> to_area = shadow_ray_set(cornell, 24, 24);
+    ASSERT_FALSE(to_area.empty());
+    for (const Rayf& r : to_area) {
+        EXPECT_EQ(r.tfar, kShadowRayEnd);
+        const Vec3f end = r.org + r.dir;
+        EXPECT_NEAR(length(end - centre), 0.0f, 1e-4f * length(l.edge1));
+    }
+    // A distant light takes precedence over the area light.
+    DistantLight sun;
+    sun.direction = normalize(Vec3f{-1, -2, -3});
+    cornell.distant_lights.push_back(sun);
+    const std::vector<Rayf> to_sun = shadow_ray_set(cornell, 24, 24);
+    ASSERT_EQ(to_sun.size(), to_area.size());
+    for (const Rayf& r : to_sun) {
+        EXPECT_EQ(r.tfar, std::numeric_limits<float>::infinity());
+        EXPECT_EQ(r.dir, -sun.direction);
+    }
 }
 
 }  // namespace
