@@ -3,9 +3,10 @@
 
 namespace raypack::app {
 
-/// Keeps large allocations on the heap, never returns freed heap memory to
-/// the system, and backs the first HeapReserve bytes of the heap with
-/// transparent huge pages where the kernel offers them (madvise mode).
+/// Keeps blocks up to 32 MiB on the heap, keeps freed heap memory (up to
+/// 1 GiB) instead of returning it to the system, and backs the first 512 MiB
+/// of the heap with transparent huge pages where the kernel offers them
+/// (its "madvise" mode).
 /// Call once, first thing in main; a no-op under AddressSanitizer.
 void reserve_heap_in_large_pages();
 
