@@ -10,8 +10,6 @@ namespace {
 
 constexpr OffsetPolicy kPolicies[] = {OffsetPolicy::Epsilon, OffsetPolicy::Scaled, OffsetPolicy::Robust};
 
-float max_abs(const Vec3f& v) { return std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}); }
-
 // Waechter & Binder, "A Fast and Robust Method for Avoiding
 // Self-Intersection", Ray Tracing Gems (2019), ch. 6, listing 6-1. The
 // published origin threshold and float offset are absolute, i.e. tuned for a
@@ -91,13 +89,5 @@ RayOffset::RayOffset(OffsetPolicy policy, const Scene& scene) : policy_(policy),
     scene_extent_ = b.empty() ? 1.0f : std::max(length(b.extent()), 1e-30f);
 }
 
-Vec3f RayOffset::offset(const Vec3f& p, const Vec3f& n) const {
-    switch (policy_) {
-        case OffsetPolicy::Epsilon: return p + n * 1e-4f;
-        case OffsetPolicy::Scaled: return p + n * (1e-4f * std::max(max_abs(p), 1e-3f * scene_extent_));
-        case OffsetPolicy::Robust: return offset_ray_origin_robust(p, n, scene_extent_);
-    }
-    return p;
-}
 
 }  // namespace raypack

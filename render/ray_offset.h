@@ -3,6 +3,8 @@
 // the new ray does not find the surface it left (self-intersection, "surface
 // acne"). Three policies, selectable with --offset, compared by
 // `raypack bench --tradeoff` (docs/accuracy.md).
+#include <algorithm>
+#include <cmath>
 #include <limits>
 #include <optional>
 #include <string>
@@ -93,5 +95,19 @@ inline void spawn_ray_to(const Vec3f& origin, const Vec3f& target, const RayOffs
 /// are absolute (extent 1); scaling them by the scene's extent makes the
 /// offset scale-invariant.
 Vec3f offset_ray_origin_robust(const Vec3f& p, const Vec3f& n, float scene_extent = 1.0f);
+
+// Inline: called for every hit and every refracted ray (an out-of-line call
+// was 7% of a mount render's samples).
+inline Vec3f RayOffset::offset(const Vec3f& p, const Vec3f& n) const {
+    switch (policy_) {
+        case OffsetPolicy::Epsilon: return p + n * 1e-4f;
+        case OffsetPolicy::Scaled: {
+            const float size = std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
+            return p + n * (1e-4f * std::max(size, 1e-3f * scene_extent_));
+        }
+        case OffsetPolicy::Robust: return offset_ray_origin_robust(p, n, scene_extent_);
+    }
+    return p;
+}
 
 }  // namespace raypack
