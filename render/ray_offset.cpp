@@ -89,5 +89,4 @@ RayOffset::RayOffset(OffsetPolicy policy, const Scene& scene) : policy_(policy),
     scene_extent_ = b.empty() ? 1.0f : std::max(length(b.extent()), 1e-30f);
 }
 
-
 }  // namespace raypack

@@ -230,6 +230,7 @@ private:
         const Vec3f above = offset_.offset(p, ng);
 
         tree.color[std::size_t(i)] = m.color * (intensity_ * m.kd);  // ambient
+        const float cutoff = specular_cutoff_[surf.material];
         for (std::size_t li = 0; li < scene_.lights.size(); ++li) {
             const PointLight& light = scene_.lights[li];
             const Vec3f to_light = light.position - above;
@@ -242,7 +243,7 @@ private:
                 1.0f / (options_.atten_c2 * dist * dist + options_.atten_c1 * dist + options_.atten_c0);
             spawn_ray_to(above, light.position, offset_, s.shadows.rays[li].emplace_back());
             s.shadows.owner[li].push_back(i);
-            s.shadows.contribution[li].push_back(direct(m, specular_cutoff_[surf.material], light.color * (intensity_ * atten), ns, l, view));
+            s.shadows.contribution[li].push_back(direct(m, cutoff, light.color * (intensity_ * atten), ns, l, view));
         }
         std::size_t bucket = scene_.lights.size();
         for (const DistantLight& light : scene_.distant_lights) {
@@ -251,7 +252,7 @@ private:
                 ++s.stats.shadow_rays;
                 spawn_ray(above, l, offset_, s.shadows.rays[bucket].emplace_back());
                 s.shadows.owner[bucket].push_back(i);
-                s.shadows.contribution[bucket].push_back(direct(m, specular_cutoff_[surf.material], light.color * intensity_, ns, l, view));
+                s.shadows.contribution[bucket].push_back(direct(m, cutoff, light.color * intensity_, ns, l, view));
             }
             ++bucket;
         }
@@ -274,7 +275,7 @@ private:
                 ++s.stats.shadow_rays;
                 spawn_ray_to(above, ls.point, offset_, s.shadows.rays[bucket].emplace_back());
                 s.shadows.owner[bucket].push_back(i);
-                s.shadows.contribution[bucket].push_back(direct(m, specular_cutoff_[surf.material], share, ns, l, view));
+                s.shadows.contribution[bucket].push_back(direct(m, cutoff, share, ns, l, view));
             }
         }
         if (depth >= options_.max_depth) return;
