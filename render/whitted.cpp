@@ -11,6 +11,7 @@
 #include "render/camera_rays.h"
 #include "render/light_sampling.h"
 #include "render/sampling.h"
+#include "render/shading_points.h"
 #include "render/surface.h"
 #include "render/thin_lens.h"
 #include "render/tiles.h"
@@ -83,32 +84,31 @@ private:
 };
 
 /// Shadow rays of one level, grouped by light (rays toward one light
-/// converge on it, so a packet of them is coherent), each with the ray it
-/// lights and the light's contribution should it be unoccluded.
+/// converge on it, so a packet of them is coherent).
 struct ShadowBatch {
-    std::vector<std::vector<Rayf>> rays;        ///< per light
-    std::vector<std::vector<std::int32_t>> owner;
-    std::vector<std::vector<Vec3f>> contribution;
+    std::vector<ShadowQueue> per_light;
     std::vector<Rayf> all;
     std::vector<std::uint8_t> occluded;
 
     void reset(std::size_t lights) {
-        if (rays.size() < lights) {
-            rays.resize(lights);
-            owner.resize(lights);
-            contribution.resize(lights);
-        }
-        for (std::size_t l = 0; l < rays.size(); ++l) {
-            rays[l].clear();
-            owner[l].clear();
-            contribution[l].clear();
-        }
+        if (per_light.size() < lights) per_light.resize(lights);
+        for (ShadowQueue& q : per_light) q.clear();
     }
+};
+
+/// What a shaded point's reflection and refraction rays need beyond its
+/// entry in ShadingPoints.
+struct SpawnPoint {
+    Vec3f p;  ///< the hit point before the offset
+    std::uint32_t material;
+    bool front;  ///< the ray met the outward side
 };
 
 struct Scratch {
     RayTree tree;
     ShadowBatch shadows;
+    ShadingPoints points;
+    std::vector<SpawnPoint> spawn;
     std::vector<PixelXY> pixels;
     RenderStats stats;
 };
@@ -190,14 +190,17 @@ private:
     Sampler samples_;        ///< camera samples: pixel position, lens, glossy lobes
     Sampler light_samples_;  ///< points on area lights
 
+    /// Shades the rays [begin, end) of the tree, which are of depth `depth`:
+    /// first each hit's surface (in ray order), then each point light for
+    /// all points at once, then the other lights and the children.
     void shade_level(std::size_t begin, std::size_t end, int depth, Scratch& s) const {
         RayTree& tree = s.tree;
-        ShadowBatch& shadows = s.shadows;
-        shadows.reset(light_buckets());
+        s.shadows.reset(light_buckets());
+        s.points.clear();
+        s.spawn.clear();
         RenderStats& stats = s.stats;
         for (std::size_t i = begin; i < end; ++i) {
-            const Rayf ray = tree.rays[i];
-            const Hitf hit = tree.hits[i];
+            const Hitf& hit = tree.hits[i];
             if (depth == 1) {
                 ++stats.eye_rays;
                 stats.eye_hits += hit.found();
@@ -206,12 +209,22 @@ private:
                 tree.color[i] = scene_.background;
                 continue;
             }
-            shade(std::int32_t(i), ray, hit, depth, s);
+            add_point(std::int32_t(i), tree.rays[i], hit, s);
         }
+        const Attenuation attenuation{options_.atten_c0, options_.atten_c1, options_.atten_c2};
+        for (std::size_t li = 0; li < scene_.lights.size(); ++li)
+            stats.shadow_rays +=
+                shade_point_light(s.points, scene_.lights[li], intensity_, attenuation, offset_, s.shadows.per_light[li]);
+        if (!scene_.distant_lights.empty() || !scene_.area_lights.empty())
+            for (std::size_t j = 0; j < s.points.size(); ++j) shade_other_lights(j, depth, s);
+        if (depth < options_.max_depth)
+            for (std::size_t j = 0; j < s.points.size(); ++j) spawn_children(j, depth, s);
         trace_shadows(s);
     }
 
-    void shade(std::int32_t i, const Rayf& ray, const Hitf& hit, int depth, Scratch& s) const {
+    /// The hit's surface as a shading point, its ambient term as the colour
+    /// (or the colour of the area light it lies on).
+    void add_point(std::int32_t i, const Rayf& ray, const Hitf& hit, Scratch& s) const {
         RayTree& tree = s.tree;
         const Surface surf = surface_at(scene_, ray, hit);
         const Material& m = scene_.materials[surf.material];
@@ -227,32 +240,30 @@ private:
         Vec3f ns = front ? surf.shading_normal : -surf.shading_normal;
         if (dot(ns, ng) < 0) ns = ng;  // interpolated normal bent past the surface
         const Vec3f p = offset_.hit_point(scene_, ray, hit, surf.point);
-        const Vec3f above = offset_.offset(p, ng);
-
         tree.color[std::size_t(i)] = m.color * (intensity_ * m.kd);  // ambient
-        const float cutoff = specular_cutoff_[surf.material];
-        for (std::size_t li = 0; li < scene_.lights.size(); ++li) {
-            const PointLight& light = scene_.lights[li];
-            const Vec3f to_light = light.position - above;
-            const float dist = length(to_light);
-            const Vec3f l = to_light / dist;
-            // SPD protocol: no shadow ray when the surface faces away from the light.
-            if (dot(ns, l) <= 0 || dot(ng, l) <= 0) continue;
-            ++s.stats.shadow_rays;
-            const float atten =
-                1.0f / (options_.atten_c2 * dist * dist + options_.atten_c1 * dist + options_.atten_c0);
-            spawn_ray_to(above, light.position, offset_, s.shadows.rays[li].emplace_back());
-            s.shadows.owner[li].push_back(i);
-            s.shadows.contribution[li].push_back(direct(m, cutoff, light.color * (intensity_ * atten), ns, l, view));
-        }
+        s.points.add(i, view, ns, ng, offset_.offset(p, ng), m, specular_cutoff_[surf.material]);
+        s.spawn.push_back({p, surf.material, front});
+    }
+
+    /// Distant and area lights at shading point j (point lights are done
+    /// for all points at once by shade_point_light).
+    void shade_other_lights(std::size_t j, int depth, Scratch& s) const {
+        const RayTree& tree = s.tree;
+        const ShadingPoints& pts = s.points;
+        const std::int32_t i = pts.ray(j);
+        const Material& m = scene_.materials[s.spawn[j].material];
+        const float cutoff = specular_cutoff_[s.spawn[j].material];
+        const Vec3f view = pts.view(j), ns = pts.shading_normal(j), ng = pts.geometric_normal(j);
+        const Vec3f above = pts.above(j);
         std::size_t bucket = scene_.lights.size();
         for (const DistantLight& light : scene_.distant_lights) {
             const Vec3f l = -light.direction;
             if (dot(ns, l) > 0 && dot(ng, l) > 0) {
                 ++s.stats.shadow_rays;
-                spawn_ray(above, l, offset_, s.shadows.rays[bucket].emplace_back());
-                s.shadows.owner[bucket].push_back(i);
-                s.shadows.contribution[bucket].push_back(direct(m, cutoff, light.color * intensity_, ns, l, view));
+                ShadowQueue& q = s.shadows.per_light[bucket];
+                spawn_ray(above, l, offset_, q.rays.emplace_back());
+                q.owner.push_back(i);
+                q.contribution.push_back(direct(m, cutoff, light.color * intensity_, ns, l, view));
             }
             ++bucket;
         }
@@ -263,8 +274,8 @@ private:
         for (std::size_t a = 0; a < scene_.area_lights.size(); ++a, ++bucket) {
             const AreaLight& light = scene_.area_lights[a];
             const Vec3f share = light.color * (intensity_ / float(n_light));
-            for (int j = 0; j < n_light; ++j) {
-                Sample2 u = light_samples_.get(tree.sample[std::size_t(i)], j, depth * 64 + int(a % 64));
+            for (int k = 0; k < n_light; ++k) {
+                Sample2 u = light_samples_.get(tree.sample[std::size_t(i)], k, depth * 64 + int(a % 64));
                 if (!options_.distribution && light.shape == AreaLightShape::Sphere) u = {0, 0};  // the facing point
                 const LightSample ls = sample_area_light(light, above, u);
                 const Vec3f to_light = ls.point - above;
@@ -273,12 +284,24 @@ private:
                 const Vec3f l = to_light / dist;
                 if (dot(ns, l) <= 0 || dot(ng, l) <= 0) continue;
                 ++s.stats.shadow_rays;
-                spawn_ray_to(above, ls.point, offset_, s.shadows.rays[bucket].emplace_back());
-                s.shadows.owner[bucket].push_back(i);
-                s.shadows.contribution[bucket].push_back(direct(m, cutoff, share, ns, l, view));
+                ShadowQueue& q = s.shadows.per_light[bucket];
+                spawn_ray_to(above, ls.point, offset_, q.rays.emplace_back());
+                q.owner.push_back(i);
+                q.contribution.push_back(direct(m, cutoff, share, ns, l, view));
             }
         }
-        if (depth >= options_.max_depth) return;
+    }
+
+    /// The reflection and refraction rays of shading point j (SPD protocol).
+    void spawn_children(std::size_t j, int depth, Scratch& s) const {
+        RayTree& tree = s.tree;
+        const ShadingPoints& pts = s.points;
+        const std::int32_t i = pts.ray(j);
+        const SpawnPoint& sp = s.spawn[j];
+        const Material& m = scene_.materials[sp.material];
+        const Vec3f view = pts.view(j), ns = pts.shading_normal(j), ng = pts.geometric_normal(j);
+        const Vec3f above = pts.above(j), p = sp.p;
+        const bool front = sp.front;
 
         // SPD protocol (Readme, items 8 and 9): reflective and transmitting
         // surfaces both spawn a reflection ray, weighted by Ks; transmitters
@@ -346,14 +369,14 @@ private:
     void trace_shadows(Scratch& s) const {
         ShadowBatch& b = s.shadows;
         b.all.clear();
-        for (const auto& rays : b.rays) b.all.insert(b.all.end(), rays.begin(), rays.end());
+        for (const ShadowQueue& q : b.per_light) b.all.insert(b.all.end(), q.rays.begin(), q.rays.end());
         if (b.all.empty()) return;
         b.occluded.resize(b.all.size());
         accel_.occluded_packets(options_.secondary_packet, b.all, b.occluded);
         std::size_t k = 0;
-        for (std::size_t l = 0; l < b.rays.size(); ++l)
-            for (std::size_t j = 0; j < b.rays[l].size(); ++j, ++k)
-                if (!b.occluded[k]) s.tree.color[std::size_t(b.owner[l][j])] += b.contribution[l][j];
+        for (const ShadowQueue& q : b.per_light)
+            for (std::size_t j = 0; j < q.rays.size(); ++j, ++k)
+                if (!b.occluded[k]) s.tree.color[std::size_t(q.owner[j])] += q.contribution[j];
     }
 };
 

@@ -1,0 +1,114 @@
+#include <bit>
+#include <cmath>
+
+#include "kernels/simd.h"
+#include "render/ray_offset.h"
+#include "render/shading_points.h"
+
+namespace raypack {
+
+void ShadingPoints::grow() {
+    const std::size_t size = std::max<std::size_t>(2 * ray_.size(), 256 + kSpare);
+    ray_.resize(size);
+    for (auto* column : {view_, ns_, ng_, above_, color_})
+        for (int a = 0; a < 3; ++a) column[a].resize(size);
+    for (auto* column : {&kd_, &ks_, &shine_, &cutoff_}) column->resize(size);
+}
+
+void ShadingPoints::add(std::int32_t ray, const Vec3f& view, const Vec3f& ns, const Vec3f& ng, const Vec3f& above,
+                        const Material& m, float specular_cutoff) {
+    if (count_ + kSpare >= ray_.size()) grow();
+    const std::size_t j = count_++;
+    ray_[j] = ray;
+    for (int a = 0; a < 3; ++a) {
+        view_[a][j] = view[a];
+        ns_[a][j] = ns[a];
+        ng_[a][j] = ng[a];
+        above_[a][j] = above[a];
+        color_[a][j] = m.color[a];
+    }
+    kd_[j] = m.kd;
+    ks_[j] = m.ks;
+    shine_[j] = m.shine;
+    cutoff_[j] = specular_cutoff;
+}
+
+/// The widest lanes this build has.
+#if defined(__AVX512BW__)
+inline constexpr int kShadeLanes = 16;
+#elif defined(__AVX2__)
+inline constexpr int kShadeLanes = 8;
+#elif defined(__SSE4_2__)
+inline constexpr int kShadeLanes = 4;
+#else
+inline constexpr int kShadeLanes = 1;
+#endif
+
+struct PointLightLanes {
+    using F = vfloat<kShadeLanes>;
+    static constexpr int K = kShadeLanes;
+
+    static Vec3<F> load3(const std::vector<float> (&a)[3], std::size_t j) {
+        return {load_lanes<F>(&a[0][j]), load_lanes<F>(&a[1][j]), load_lanes<F>(&a[2][j])};
+    }
+
+    static std::size_t run(const ShadingPoints& pts, const PointLight& light, float intensity,
+                           const Attenuation& att, const RayOffset& offset, ShadowQueue& out) {
+        const Vec3<F> position{F(light.position.x), F(light.position.y), F(light.position.z)};
+        std::size_t emitted = 0;
+        alignas(64) float contribution[3][K], rv_lanes[K], specular[K];
+        for (std::size_t j = 0; j < pts.count_; j += K) {
+            const std::size_t left = pts.count_ - j;
+            const std::uint32_t in_range = left >= std::size_t(K) ? (K == 32 ? ~0u : (1u << K) - 1) : (1u << left) - 1;
+            const Vec3<F> above = load3(pts.above_, j);
+            const Vec3<F> ns = load3(pts.ns_, j), ng = load3(pts.ng_, j), view = load3(pts.view_, j);
+            // The recursive tracer's expressions, lane by lane (whitted.cpp).
+            const Vec3<F> to_light = position - above;
+            const F dist = vsqrt(dot(to_light, to_light));
+            const Vec3<F> l = to_light / dist;
+            const F ns_l = dot(ns, l), ng_l = dot(ng, l);
+            // `ns_l <= 0 || ng_l <= 0` skips the light: NaN lanes go on, as there.
+            std::uint32_t faces = in_range & ~mask_bits(ns_l <= F(0.0f)) & ~mask_bits(ng_l <= F(0.0f));
+            if (faces == 0) continue;
+            const F atten = F(1.0f) / (F(att.c2) * dist * dist + F(att.c1) * dist + F(att.c0));
+            const F scale = F(intensity) * atten;
+            const Vec3<F> light_color{F(light.color.x) * scale, F(light.color.y) * scale, F(light.color.z) * scale};
+            const F diffuse = load_lanes<F>(&pts.kd_[j]) * ns_l;
+            const Vec3<F> r = ns * (F(2.0f) * ns_l) - l;  // mirror of l about the normal
+            const F minus_rv = -dot(r, view);
+            const F rv = select(F(0.0f) < minus_rv, minus_rv, F(0.0f));  // std::max(0, -dot(r, view))
+            // Phong's powf, per lane, where glibc's result is not +0 anyway.
+            const std::uint32_t shiny = faces & mask_bits(load_lanes<F>(&pts.ks_[j]) > F(0.0f)) &
+                                        mask_bits(rv > load_lanes<F>(&pts.cutoff_[j]));
+            store_lanes(specular, F(0.0f));
+            if (shiny != 0) {
+                store_lanes(rv_lanes, rv);
+                for (std::uint32_t bits = shiny; bits != 0; bits &= bits - 1) {
+                    const int i = std::countr_zero(bits);
+                    specular[i] = pts.ks_[j + std::size_t(i)] * std::pow(rv_lanes[i], pts.shine_[j + std::size_t(i)]);
+                }
+            }
+            const F spec = load_lanes<F>(specular);
+            const Vec3<F> color = load3(pts.color_, j);
+            store_lanes(contribution[0], light_color.x * color.x * diffuse + light_color.x * spec);
+            store_lanes(contribution[1], light_color.y * color.y * diffuse + light_color.y * spec);
+            store_lanes(contribution[2], light_color.z * color.z * diffuse + light_color.z * spec);
+            for (std::uint32_t bits = faces; bits != 0; bits &= bits - 1) {
+                const int i = std::countr_zero(bits);
+                const std::size_t p = j + std::size_t(i);
+                spawn_ray_to(pts.above(p), light.position, offset, out.rays.emplace_back());
+                out.owner.push_back(pts.ray_[p]);
+                out.contribution.push_back({contribution[0][i], contribution[1][i], contribution[2][i]});
+            }
+            emitted += std::size_t(std::popcount(faces));
+        }
+        return emitted;
+    }
+};
+
+std::size_t shade_point_light(const ShadingPoints& points, const PointLight& light, float intensity,
+                              const Attenuation& attenuation, const RayOffset& offset, ShadowQueue& out) {
+    return PointLightLanes::run(points, light, intensity, attenuation, offset, out);
+}
+
+}  // namespace raypack
