@@ -36,30 +36,33 @@ constexpr std::size_t kMaxBatch = 16384;
 
 /// The ray tree of one batch of eye rays, stored level by level: the rays of
 /// depth d occupy [level_begin, level_end) and their children are appended
-/// after them. Each ray keeps its local colour (ambient and direct light)
-/// and its children; once the deepest level is shaded, colours are summed
-/// bottom-up in the order the recursive tracer added them, so the result is
-/// the recursion's bit for bit.
+/// after them. Each ray keeps its local colour (ambient and direct light);
+/// each ray with children has a link to them. Once the deepest level is
+/// shaded, colours are summed bottom-up in the order the recursive tracer
+/// added them, so the result is the recursion's bit for bit.
 struct RayTree {
+    /// A ray's children and their weights.
+    struct Link {
+        std::int32_t parent;
+        std::int32_t reflect = -1, refract = -1;  ///< -1 if none
+        float ks = 0, kt = 0;                     ///< kt: 0 if not transmitting
+    };
     std::vector<Rayf> rays;
     std::vector<Hitf> hits;
     std::vector<Vec3f> color;
-    std::vector<std::int32_t> reflect, refract;  ///< child indices, -1 if none
-    std::vector<float> ks, kt;                   ///< weights of the children (kt: 0 if not transmitting)
-    std::vector<std::uint64_t> sample;           ///< pixel * spp + sample index of the camera sample
-    std::size_t count = 0;                       ///< rays in use; the arrays only grow
+    std::vector<std::uint64_t> sample;  ///< pixel * spp + sample index of the camera sample
+    std::vector<Link> links;            ///< in the order of their parents
+    std::size_t count = 0;              ///< rays in use; the arrays only grow
 
     /// Starts a tree of `eye` rays (to be written to rays[0 .. eye)).
     void reset(std::size_t eye) {
-        count = 0;
         reserve(eye);
-        for (std::size_t i = 0; i < eye; ++i) init(i);
         count = eye;
+        links.clear();
     }
     /// A new ray (set by the caller through the returned index).
     std::int32_t add() {
         reserve(count + 1);
-        init(count);
         return std::int32_t(count++);
     }
 
@@ -70,16 +73,7 @@ private:
         rays.resize(size);
         hits.resize(size);
         color.resize(size);
-        reflect.resize(size);
-        refract.resize(size);
-        ks.resize(size);
-        kt.resize(size);
         sample.resize(size);
-    }
-    void init(std::size_t i) {
-        hits[i] = Hitf{};
-        reflect[i] = refract[i] = -1;
-        ks[i] = kt[i] = 0;
     }
 };
 
@@ -136,13 +130,9 @@ public:
         return scene_.lights.size() + scene_.distant_lights.size() + scene_.area_lights.size();
     }
 
-    /// Position in the image of camera sample `index` of pixel (x, y): the
-    /// pixel's centre for Whitted, else drawn from the pixel filter.
+    /// Camera sample `index` of pixel (x, y) for distribution ray tracing:
+    /// its position drawn from the pixel filter, its lens point sampled.
     void camera_sample(int x, int y, int index, Rayf& ray, const CameraFrame& frame) const {
-        if (!options_.distribution) {
-            ray = camera_ray(frame, float(x) + 0.5f, float(y) + 0.5f);
-            return;
-        }
         const std::uint64_t pixel = std::uint64_t(y) * std::uint64_t(options_.width) + std::uint64_t(x);
         sampled_camera_ray(frame, scene_.camera, samples_, options_.filter, samples_.pixel(pixel), x, y, index, ray);
     }
@@ -168,15 +158,16 @@ public:
             end = tree.count;
         }
         // Children come after their parents: one backward pass sums the tree.
-        for (std::size_t i = tree.count; i-- > 0;) {
-            Vec3f c = tree.color[i];
-            if (tree.reflect[i] >= 0) c += tree.color[std::size_t(tree.reflect[i])] * tree.ks[i];
-            if (tree.kt[i] > 0) {
+        for (std::size_t k = tree.links.size(); k-- > 0;) {
+            const RayTree::Link& link = tree.links[k];
+            Vec3f c = tree.color[std::size_t(link.parent)];
+            if (link.reflect >= 0) c += tree.color[std::size_t(link.reflect)] * link.ks;
+            if (link.kt > 0) {
                 // Total internal reflection sends the transmitted share along the reflection ray.
-                const std::int32_t t = tree.refract[i] >= 0 ? tree.refract[i] : tree.reflect[i];
-                c += tree.color[std::size_t(t)] * tree.kt[i];
+                const std::int32_t t = link.refract >= 0 ? link.refract : link.reflect;
+                c += tree.color[std::size_t(t)] * link.kt;
             }
-            tree.color[i] = c;
+            tree.color[std::size_t(link.parent)] = c;
         }
     }
 
@@ -299,14 +290,12 @@ private:
         const std::int32_t i = pts.ray(j);
         const SpawnPoint& sp = s.spawn[j];
         const Material& m = scene_.materials[sp.material];
-        const Vec3f view = pts.view(j), ns = pts.shading_normal(j), ng = pts.geometric_normal(j);
-        const Vec3f above = pts.above(j), p = sp.p;
-        const bool front = sp.front;
-
         // SPD protocol (Readme, items 8 and 9): reflective and transmitting
         // surfaces both spawn a reflection ray, weighted by Ks; transmitters
         // also spawn a refraction ray unless total internal reflection occurs,
         // in which case the reflection carries the transmitted share as well.
+        if (!(m.ks > 0 || m.transmittance > 0)) return;
+        const Vec3f view = pts.view(j), ns = pts.shading_normal(j), ng = pts.geometric_normal(j);
         Vec3f reflected_dir = view - ns * (2.0f * dot(view, ns));
         if (options_.distribution && m.gloss > 0) {
             // Glossy: a direction of the Phong lobe about the mirror direction;
@@ -318,18 +307,16 @@ private:
             const Vec3f d = OrthonormalBasis<float>(mirror).to_world(phong_lobe(m.gloss, u.x, u.y));
             if (dot(d, ng) > 0) reflected_dir = d;
         }
-        if (m.ks > 0 || m.transmittance > 0) {
-            ++s.stats.reflect_rays;
-            const std::int32_t child = tree.add();
-            tree.sample[std::size_t(child)] = tree.sample[std::size_t(i)];
-            spawn_ray(above, reflected_dir, offset_, tree.rays[std::size_t(child)]);
-            tree.reflect[std::size_t(i)] = child;
-            tree.ks[std::size_t(i)] = m.ks;
-        }
+        RayTree::Link& link = tree.links.emplace_back(RayTree::Link{i});
+        ++s.stats.reflect_rays;
+        link.reflect = tree.add();
+        link.ks = m.ks;
+        tree.sample[std::size_t(link.reflect)] = tree.sample[std::size_t(i)];
+        spawn_ray(pts.above(j), reflected_dir, offset_, tree.rays[std::size_t(link.reflect)]);
         if (m.transmittance > 0) {
-            tree.kt[std::size_t(i)] = m.transmittance;
+            link.kt = m.transmittance;
             // Snell's law; entering when the ray meets the outward side.
-            const float eta = front ? 1.0f / m.ior : m.ior;
+            const float eta = sp.front ? 1.0f / m.ior : m.ior;
             const float cos_i = -dot(view, ns);
             const float k = 1.0f - eta * eta * (1.0f - cos_i * cos_i);
             if (k >= 0) {
@@ -337,8 +324,8 @@ private:
                 const Vec3f dir = view * eta + ns * (eta * cos_i - std::sqrt(k));
                 const std::int32_t child = tree.add();
                 tree.sample[std::size_t(child)] = tree.sample[std::size_t(i)];
-                spawn_ray(offset_.offset(p, -ng), dir, offset_, tree.rays[std::size_t(child)]);
-                tree.refract[std::size_t(i)] = child;
+                spawn_ray(offset_.offset(sp.p, -ng), dir, offset_, tree.rays[std::size_t(child)]);
+                link.refract = child;
             }
         }
     }
@@ -527,11 +514,21 @@ RenderStats render_whitted(const Scene& scene, const Accel& accel, const Whitted
             const std::size_t n = s.pixels.size() * std::size_t(k1 - k0);
             s.tree.reset(n);
             std::size_t i = 0;
-            for (const PixelXY& px : s.pixels) {
-                const std::uint64_t pixel = std::uint64_t(px.y) * std::uint64_t(options.width) + std::uint64_t(px.x);
-                for (int k = k0; k < k1; ++k, ++i) {
-                    tracer.camera_sample(px.x, px.y, k, s.tree.rays[i], frame);
-                    s.tree.sample[i] = pixel * std::uint64_t(spp) + std::uint64_t(k);
+            if (!options.distribution) {
+                // Through the pixel centres. The frame is copied so that the
+                // compiler knows the ray stores cannot change it.
+                const CameraFrame f = frame;
+                for (const PixelXY& px : s.pixels) {
+                    s.tree.rays[i] = camera_ray(f, float(px.x) + 0.5f, float(px.y) + 0.5f);
+                    s.tree.sample[i++] = std::uint64_t(px.y) * std::uint64_t(options.width) + std::uint64_t(px.x);
+                }
+            } else {
+                for (const PixelXY& px : s.pixels) {
+                    const std::uint64_t pixel = std::uint64_t(px.y) * std::uint64_t(options.width) + std::uint64_t(px.x);
+                    for (int k = k0; k < k1; ++k, ++i) {
+                        tracer.camera_sample(px.x, px.y, k, s.tree.rays[i], frame);
+                        s.tree.sample[i] = pixel * std::uint64_t(spp) + std::uint64_t(k);
+                    }
                 }
             }
             tracer.trace(n, s);
