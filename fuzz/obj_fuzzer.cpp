@@ -1,4 +1,4 @@
-// The OBJ reader (tinyobjloader and raypack's checks) on arbitrary bytes, in
+// The OBJ reader (scene/obj_loader.cpp) on arbitrary bytes, in
 // memory: load_obj_file reads the file and calls the same load_obj_text.
 #include <cstddef>
 #include <cstdint>

@@ -130,6 +130,27 @@ TEST_F(ObjLoader, ConcaveFaceAndGroupsAndMaterials) {
     EXPECT_TRUE(s.has_camera);
 }
 
+TEST_F(ObjLoader, RelativeIndicesCountFromTheirLineAndColoursAreSkipped) {
+    // -1 is the last vertex defined before the face's line, whatever comes
+    // after; positive indices may name vertices defined later; "v x y z w"
+    // and "v x y z r g b" keep x y z; a statement raypack does not use
+    // ("l", "p", "vp", "curv") is skipped.
+    const Scene s = load(
+        "v 0 0 0 1\nv 1 0 0 0.5 0.5 0.5\nv 0 1 0\n"
+        "f -3 -2 -1\n"
+        "v 5 5 5\n"
+        "f -4 -3 -2\n"
+        "f 1 2 5\n"
+        "l 1 2\np 1\nvp 0.5\n"
+        "v 0 0 7\n");
+    ASSERT_EQ(s.triangles.size(), 3u);
+    EXPECT_EQ(s.triangles.p0[0], (Vec3f{0, 0, 0}));
+    EXPECT_EQ(s.triangles.p1[0], (Vec3f{1, 0, 0}));
+    EXPECT_EQ(s.triangles.p2[0], (Vec3f{0, 1, 0}));
+    EXPECT_EQ(s.triangles.p2[1], (Vec3f{0, 1, 0}));  // -2 on the line after "v 5 5 5"
+    EXPECT_EQ(s.triangles.p2[2], (Vec3f{0, 0, 7}));  // defined after the face
+}
+
 TEST_F(ObjLoader, ZeroNormalsFallBackToFlat) {
     const Scene s = load("v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 0\nvn 0 0 1\nf 1//1 2//2 3//2\n");
     ASSERT_EQ(s.triangles.size(), 1u);
@@ -151,7 +172,11 @@ TEST_F(ObjLoader, Errors) {
     expect_error(tri + "f -1 -2 -4\n", 4, "vertex index out of range");
     expect_error(tri + "vn 0 0 1\nf 1//1 2//1 3//2\n", 5, "normal index out of range");
     expect_error(tri + "f 1 2\n", 4, "at least 3 vertices");
-    expect_error(tri + "\n\nf 0 1 2\n", 6, "tinyobjloader");
+    expect_error(tri + "\n\nf 0 1 2\n", 6, "index 0 in face");
+    expect_error(tri + "f 1 2 x\n", 4, "bad vertex reference 'x'");
+    expect_error(tri + "f 1 2 3/1/1/1\n", 4, "bad vertex reference");
+    expect_error(tri + "f 1 2 3//\n", 4, "bad vertex reference");
+    expect_error(tri + "f 1 2 99999999999999999999\n", 4, "bad vertex reference");
     expect_error(tri, 0, "no faces");
     expect_error("", 0, "no faces");
     std::string big = "f";
