@@ -29,7 +29,7 @@ float tent_inverse(float u) { return u < 0.5f ? std::sqrt(2.0f * u) - 1.0f : 1.0
 
 }  // namespace
 
-Sample2 filter_offset(PixelFilter filter, Sample2 u) {
+Sample2 shaped_filter_offset(PixelFilter filter, Sample2 u) {
     switch (filter) {
         case PixelFilter::Box: return {u.x - 0.5f, u.y - 0.5f};
         case PixelFilter::Tent: return {tent_inverse(u.x), tent_inverse(u.y)};

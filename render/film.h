@@ -4,6 +4,7 @@
 // shape and every sample weighs the same) and the average of a pixel's
 // samples.
 #include <optional>
+#include <span>
 #include <string_view>
 #include <vector>
 
@@ -21,9 +22,16 @@ enum class PixelFilter : std::uint8_t {
 std::optional<PixelFilter> pixel_filter_from_name(std::string_view name);
 const char* pixel_filter_name(PixelFilter filter);
 
+/// filter_offset for the tent and the Gaussian.
+Sample2 shaped_filter_offset(PixelFilter filter, Sample2 u);
+
 /// Offset from the pixel's centre, in pixels, of the sample drawn from the
-/// filter by the unit-square point `u`.
-Sample2 filter_offset(PixelFilter filter, Sample2 u);
+/// filter by the unit-square point `u`. The box inline: it runs for every
+/// camera sample.
+inline Sample2 filter_offset(PixelFilter filter, Sample2 u) {
+    if (filter == PixelFilter::Box) return {u.x - 0.5f, u.y - 0.5f};
+    return shaped_filter_offset(filter, u);
+}
 
 /// Sums of samples per pixel (and of their squares), resolved into their
 /// average and an estimate of its noise.
@@ -31,10 +39,17 @@ class Film {
 public:
     Film(int width, int height)
         : sum_(width, height), sum_sq_(width, height), count_(std::size_t(width) * std::size_t(height), 0) {}
-    void add(int x, int y, const Vec3f& color) {
-        sum_.set(x, y, sum_.at(x, y) + color);
-        sum_sq_.set(x, y, sum_sq_.at(x, y) + color * color);
-        ++count_[std::size_t(y) * std::size_t(sum_.width) + std::size_t(x)];
+    void add(int x, int y, const Vec3f& color) { add(x, y, {&color, 1}); }
+    /// Samples of one pixel, added in order (the same sums as one add each).
+    void add(int x, int y, std::span<const Vec3f> colors) {
+        Vec3f sum = sum_.at(x, y), sum_sq = sum_sq_.at(x, y);
+        for (const Vec3f& c : colors) {
+            sum = sum + c;
+            sum_sq = sum_sq + c * c;
+        }
+        sum_.set(x, y, sum);
+        sum_sq_.set(x, y, sum_sq);
+        count_[std::size_t(y) * std::size_t(sum_.width) + std::size_t(x)] += int(colors.size());
     }
     Image resolve() const;
     /// The standard error of each pixel's mean (sample variance / count,

@@ -538,7 +538,8 @@ RenderStats render_whitted(const Scene& scene, const Accel& accel, const Whitted
                     image.set(px.x, px.y, s.tree.color[i++]);  // Whitted: exactly the ray's colour
                     continue;
                 }
-                for (int k = k0; k < k1; ++k) film->add(px.x, px.y, s.tree.color[i++]);
+                film->add(px.x, px.y, std::span(s.tree.color).subspan(i, std::size_t(k1 - k0)));
+                i += std::size_t(k1 - k0);
             }
         }
         progress.add(s.pixels.size());
