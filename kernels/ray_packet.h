@@ -30,27 +30,39 @@ template <int K> using RayPacket = RayLanes<vfloat<K>>;
 template <int K> using HitPacket = HitLanes<vfloat<K>>;
 
 /// Loads up to K rays (count <= K) into a packet; the lanes past `count`
-/// repeat the last ray and come back inactive in `valid`. rdir is computed
-/// per ray, at width 1, by `rcp` (`--rcp`), so lanes get the single ray's bits.
+/// repeat the last ray and come back inactive in `valid`. rdir gets the
+/// single ray's bits: `--rcp exact` divides all lanes at once (a division is
+/// correctly rounded at any width; K scalar divisions per axis were 5% of a
+/// gears render), `--rcp approx` runs the scalar estimate lane by lane.
 template <int K>
 RayPacket<K> load_packet(std::span<const Rayf> rays, vmask<K>& valid, RcpMethod rcp = RcpMethod::Exact) {
     using F = vfloat<K>;
-    alignas(64) float f[11][K];
+    alignas(64) float f[8][K];
     alignas(64) float active[K];
     const std::size_t n = rays.size();
     for (int i = 0; i < K; ++i) {
         const Rayf& r = rays[std::min<std::size_t>(std::size_t(i), n - 1)];
-        const Vec3f rd = reciprocal(r.dir, rcp);
-        const float vals[11] = {r.org.x, r.org.y, r.org.z, r.dir.x, r.dir.y, r.dir.z, rd.x, rd.y, rd.z, r.tnear, r.tfar};
-        for (int c = 0; c < 11; ++c) f[c][i] = vals[c];
+        const float vals[8] = {r.org.x, r.org.y, r.org.z, r.dir.x, r.dir.y, r.dir.z, r.tnear, r.tfar};
+        for (int c = 0; c < 8; ++c) f[c][i] = vals[c];
         active[i] = std::size_t(i) < n ? 1.0f : 0.0f;
     }
     RayPacket<K> p;
     p.org = {load_lanes<F>(f[0]), load_lanes<F>(f[1]), load_lanes<F>(f[2])};
     p.dir = {load_lanes<F>(f[3]), load_lanes<F>(f[4]), load_lanes<F>(f[5])};
-    p.rdir = {load_lanes<F>(f[6]), load_lanes<F>(f[7]), load_lanes<F>(f[8])};
-    p.tnear = load_lanes<F>(f[9]);
-    p.tfar = load_lanes<F>(f[10]);
+    p.tnear = load_lanes<F>(f[6]);
+    p.tfar = load_lanes<F>(f[7]);
+    if (rcp == RcpMethod::Exact) {
+        p.rdir = reciprocal(p.dir);
+    } else {
+        alignas(64) float rd[3][K];
+        for (int i = 0; i < K; ++i) {
+            const Vec3f r = reciprocal(Vec3f{f[3][i], f[4][i], f[5][i]}, rcp);
+            rd[0][i] = r.x;
+            rd[1][i] = r.y;
+            rd[2][i] = r.z;
+        }
+        p.rdir = {load_lanes<F>(rd[0]), load_lanes<F>(rd[1]), load_lanes<F>(rd[2])};
+    }
     valid = load_lanes<F>(active) > F(0.0f);
     return p;
 }
