@@ -1,4 +1,5 @@
 // Wavefront OBJ (vertices, normals and faces), plus the camera and light OBJ lacks.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -22,8 +23,11 @@ namespace {
 /// triangulation work; real meshes stay far below it).
 constexpr std::size_t kMaxFaceVertices = 255;
 
-/// A face corner's index not given ("f 1 2 3" has no normal indices).
-constexpr std::int64_t kAbsent = std::numeric_limits<std::int64_t>::min();
+/// A face corner's normal index not given ("f 1 2 3" has none).
+constexpr std::int32_t kAbsent = std::numeric_limits<std::int32_t>::min();
+/// An index that names no vertex whatever the file holds (0-based, below 0
+/// or above what 32 bits hold); the face reports it as out of range.
+constexpr std::int32_t kOutOfRange = -1;
 
 bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
 
@@ -57,15 +61,16 @@ float parse_coordinate(std::string_view token, const std::string& path, int line
 }
 
 /// One OBJ index (1-based, or negative: counted back from the last of the
-/// `defined` so far) as a 0-based one; out-of-range results are caught when
-/// the faces are built.
-std::int64_t parse_index(std::string_view token, std::size_t defined, std::string_view corner, const std::string& path,
+/// `defined` so far) as a 0-based one, kOutOfRange if it cannot name a
+/// vertex; indices past the end are caught when the faces are built.
+std::int32_t parse_index(std::string_view token, std::size_t defined, std::string_view corner, const std::string& path,
                          int line) {
     long long i = 0;
     if (parse_int_token(token, i) != NumberToken::Ok)
         throw SceneError(path, line, "bad vertex reference '" + std::string(corner) + "' in face");
     if (i == 0) throw SceneError(path, line, "index 0 in face '" + std::string(corner) + "' (OBJ counts from 1)");
-    return i > 0 ? std::int64_t(i) - 1 : std::int64_t(defined) + std::int64_t(i);
+    const std::int64_t index = i > 0 ? std::int64_t(i) - 1 : std::int64_t(defined) + std::int64_t(i);
+    return index < 0 || index > std::numeric_limits<std::int32_t>::max() ? kOutOfRange : std::int32_t(index);
 }
 
 /// The mesh as read: vertices, normals and each face's corners (absolute
@@ -74,7 +79,7 @@ std::int64_t parse_index(std::string_view token, std::size_t defined, std::strin
 struct ObjMesh {
     std::vector<Vec3f> positions, normals;
     struct Corner {
-        std::int64_t position, normal;  ///< normal: kAbsent if none
+        std::int32_t position, normal;  ///< normal: kAbsent if none
     };
     std::vector<Corner> corners;
     struct Face {
@@ -88,6 +93,12 @@ struct ObjMesh {
 /// mtllib, l, p ...) is skipped: raypack renders the faces with one material.
 ObjMesh parse_obj(std::string_view text, const std::string& path) {
     ObjMesh mesh;
+    // Capacity for a statement per line (only what is used gets touched):
+    // growing by doubling touched twice the memory (fresh pages are slow).
+    const auto lines = std::size_t(std::count(text.begin(), text.end(), '\n')) + 1;
+    mesh.positions.reserve(lines);
+    mesh.faces.reserve(lines);
+    mesh.corners.reserve(3 * lines);
     std::vector<std::string_view> tokens;
     int line = 0;
     for (std::size_t pos = 0; pos < text.size();) {
@@ -187,6 +198,7 @@ void append_obj_text(std::string_view text, const std::string& path, std::uint32
     const ObjMesh mesh = parse_obj(text, path);
     const auto np = std::int64_t(mesh.positions.size()), nn = std::int64_t(mesh.normals.size());
     const std::size_t triangles_before = scene.triangles.size();
+    scene.reserve_triangles(mesh.corners.size() - 2 * mesh.faces.size());  // n - 2 per polygon
     std::vector<Vec3f> pos, nrm;
     for (const ObjMesh::Face& face : mesh.faces) {
         pos.clear();

@@ -39,6 +39,15 @@ std::uint32_t Scene::add_triangle(const Vec3f& a, const Vec3f& b, const Vec3f& c
     return id;
 }
 
+void Scene::reserve_triangles(std::size_t more) {
+    const std::size_t n = triangles.size() + more;
+    for (auto* v : {&triangles.p0, &triangles.p1, &triangles.p2, &triangles.n0, &triangles.n1, &triangles.n2})
+        v->reserve(n);
+    triangles.has_normals.reserve(n);
+    prims.reserve(prims.size() + more);
+    prim_material.reserve(prim_material.size() + more);
+}
+
 std::uint32_t Scene::add_cone(const Vec3f& base, float base_r, const Vec3f& apex, float apex_r,
                               std::uint32_t material) {
     cones.base.push_back(base);

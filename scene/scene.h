@@ -154,6 +154,10 @@ struct Scene {
                                const Vec3f& nb, const Vec3f& nc, std::uint32_t material);
     std::uint32_t add_cone(const Vec3f& base, float base_r, const Vec3f& apex, float apex_r,
                            std::uint32_t material);
+    /// Room for `more` triangles, so that a loader that knows how many
+    /// follow does not grow the arrays by copying (fresh pages cost more
+    /// than the copies on the measured machines).
+    void reserve_triangles(std::size_t more);
 
     /// Recomputes `features` from the contents; loaders call it last.
     void update_features();
