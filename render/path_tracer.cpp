@@ -92,14 +92,19 @@ struct Shadows {
 
 /// A camera sample: its pixel (with the pixel's part of the sampler's hash,
 /// computed once) and its index in the pixel.
-struct SampleKey {
-    Sampler::Pixel pixel;
-    int index;
-};
+using SampleKey = Sampler::Draw;
 
 struct Scratch {
     std::vector<PixelXY> pixels;
     std::vector<SampleKey> keys;      ///< per sample of the tile
+    std::vector<Sample2> position, lens;  ///< camera samples' draws (dimensions 0 and 1)
+    /// The draws of one bounce for the paths that found a surface: what the
+    /// path's sample draws in the bounce's four dimensions (choice and
+    /// roulette, light, point on the light, direction), in bounce_draws[d]
+    /// at the path's draw_of entry.
+    std::vector<SampleKey> bounce_keys;
+    std::vector<std::int32_t> draw_of;
+    std::vector<Sample2> bounce_draws[4];
     std::vector<Vec3f> radiance;      ///< per sample of the tile
     Paths paths, next;
     Shadows shadows;
@@ -129,6 +134,7 @@ public:
                 for (const Hitf& h : p.hits) s.stats.eye_hits += h.found();
             s.next.clear();
             s.shadows.clear();
+            if (depth < path_.max_depth) draw_bounce(depth, s);
             for (std::size_t i = 0; i < p.rays.size(); ++i) bounce(i, depth, s);
             trace_shadows(s);
             std::swap(s.paths, s.next);
@@ -143,16 +149,38 @@ private:
     RayOffset offset_;
     Sampler samples_;
 
-    /// The unit-square point of dimension `dim` of sample `key`: each bounce
-    /// uses its own dimensions (light choice, light point, lobe, roulette).
-    Sample2 get(const SampleKey& key, int dim) const { return samples_.get(key.pixel, key.index, dim); }
+    /// Dimensions of the bounce at `depth`: part choice and roulette, light
+    /// choice, point on the light, direction of the bounce.
+    static int first_dimension(int depth) { return 2 + 4 * (depth - 1); }
+
+    /// The bounce's draws for every path that found a surface, all at once
+    /// (Sampler::get_many); the point on a light only if there are area lights.
+    void draw_bounce(int depth, Scratch& s) const {
+        const Paths& p = s.paths;
+        s.bounce_keys.clear();
+        s.draw_of.resize(p.rays.size());
+        for (std::size_t i = 0; i < p.rays.size(); ++i) {
+            s.draw_of[i] = p.hits[i].found() ? std::int32_t(s.bounce_keys.size()) : -1;
+            if (p.hits[i].found()) s.bounce_keys.push_back(s.keys[p.sample[i]]);
+        }
+        const int dim = first_dimension(depth);
+        for (int d = 0; d < 4; ++d) {
+            if (d == 2 && scene_.area_lights.empty()) continue;
+            s.bounce_draws[d].resize(s.bounce_keys.size());
+            samples_.get_many(s.bounce_keys, dim + d, s.bounce_draws[d].data());
+        }
+    }
+
+    /// Draw d of this bounce for path i (see Scratch::bounce_draws).
+    static Sample2 drawn(const Scratch& s, std::size_t i, int d) {
+        return s.bounce_draws[d][std::size_t(s.draw_of[i])];
+    }
 
     void bounce(std::size_t i, int depth, Scratch& s) const {
         const Paths& p = s.paths;
         const Rayf ray = p.rays[i];
         const Hitf hit = p.hits[i];
         const std::uint32_t si = p.sample[i];
-        const SampleKey key = s.keys[si];
         const Vec3f beta = p.throughput[i];
         Vec3f& L = s.radiance[si];
         if (!hit.found()) {
@@ -185,15 +213,12 @@ private:
 
         const Vec3f hp = offset_.hit_point(scene_, ray, hit, surf.point);
         const Vec3f above = offset_.offset(hp, ng);
-        // Dimensions of this bounce: part choice and roulette, light choice,
-        // point on the light, direction of the bounce.
-        const int dim = 2 + 4 * (depth - 1);
         // Choose one of the material's three parts in proportion to its weight.
         const Vec3f albedo = m.color * m.kd;
         const float wd = std::max(0.0f, max_component(albedo)), ws = std::max(0.0f, m.ks),
                     wt = std::max(0.0f, m.transmittance), total = wd + ws + wt;
         if (!(total > 0)) return;
-        const Sample2 choice = get(key, dim);
+        const Sample2 choice = drawn(s, i, 0);
         const float pick = choice.x * total;
         Vec3f dir;
         Vec3f weight;
@@ -203,8 +228,8 @@ private:
         if (pick < wd) {
             // Lambertian: next-event estimation, then a cosine-weighted bounce.
             const Vec3f f = albedo * kInvPi;
-            direct_light(si, above, ns, ng, beta * (total / wd), f, key, dim + 1, s);
-            const Sample2 u = get(key, dim + 3);
+            direct_light(i, si, above, ns, ng, beta * (total / wd), f, s);
+            const Sample2 u = drawn(s, i, 3);
             const Vec3f local = cosine_hemisphere(u.x, u.y);
             dir = OrthonormalBasis<float>(ns).to_world(local);
             bounce_pdf = local.z * kInvPi;
@@ -217,7 +242,7 @@ private:
             if (m.gloss > 0) {
                 // Normalised Phong lobe about the mirror direction, sampled
                 // exactly: the weight is 1 wherever the lobe is above the surface.
-                const Sample2 u = get(key, dim + 3);
+                const Sample2 u = drawn(s, i, 3);
                 dir = OrthonormalBasis<float>(normalize(mirror)).to_world(phong_lobe(m.gloss, u.x, u.y));
                 if (dot(dir, ng) <= 0) return;  // absorbed under the surface
             }
@@ -269,12 +294,12 @@ private:
 
     /// One shadow ray to one light chosen uniformly among all of them
     /// (point, distant, area), weighted by their number.
-    void direct_light(std::uint32_t si, const Vec3f& above, const Vec3f& ns, const Vec3f& ng, const Vec3f& beta,
-                      const Vec3f& f, const SampleKey& key, int dim, Scratch& s) const {
+    void direct_light(std::size_t path, std::uint32_t si, const Vec3f& above, const Vec3f& ns, const Vec3f& ng,
+                      const Vec3f& beta, const Vec3f& f, Scratch& s) const {
         const std::size_t n_point = scene_.lights.size(), n_distant = scene_.distant_lights.size();
         const std::size_t n = n_point + n_distant + scene_.area_lights.size();
         if (n == 0) return;
-        const Sample2 u = get(key, dim);
+        const Sample2 u = drawn(s, path, 1);
         const std::size_t pick = std::min(n - 1, std::size_t(u.x * float(n)));
         const float choose = float(n);
         Vec3f contribution, target, wi_distant;
@@ -298,7 +323,7 @@ private:
             distant = true;
         } else {
             const AreaLight& l = scene_.area_lights[pick - n_point - n_distant];
-            const Sample2 v = get(key, dim + 1);
+            const Sample2 v = drawn(s, path, 2);
             const LightSample ls = sample_area_light(l, above, v);
             const Vec3f d = ls.point - above;
             const float dist2 = dot(d, d);
@@ -358,12 +383,19 @@ RenderStats render_path(const Scene& scene, const Accel& accel, const WhittedOpt
             for (const PixelXY& px : s.pixels) {
                 const Sampler::Pixel pixel =
                     tracer.samples().pixel(std::uint64_t(px.y) * std::uint64_t(options.width) + std::uint64_t(px.x));
-                for (int k = k0; k < k1; ++k, ++i) {
-                    sampled_camera_ray(frame, scene.camera, tracer.samples(), options.filter, pixel, px.x, px.y, k,
-                                       s.paths.rays[i]);
-                    s.keys[i] = {pixel, k};
-                }
+                for (int k = k0; k < k1; ++k, ++i) s.keys[i] = {pixel, k};
             }
+            // The camera samples' draws all at once, then their rays. A
+            // pinhole needs no lens point (skipping a draw changes no other).
+            s.position.resize(n);
+            s.lens.assign(n, Sample2{});
+            tracer.samples().get_many(s.keys, 0, s.position.data());
+            if (scene.camera.lens_radius > 0) tracer.samples().get_many(s.keys, 1, s.lens.data());
+            i = 0;
+            for (const PixelXY& px : s.pixels)
+                for (int k = k0; k < k1; ++k, ++i)
+                    s.paths.rays[i] =
+                        camera_ray_of_sample(frame, scene.camera, options.filter, s.position[i], s.lens[i], px.x, px.y);
             tracer.trace(s);
             i = 0;
             for (const PixelXY& px : s.pixels) {

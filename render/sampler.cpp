@@ -4,6 +4,10 @@
 #include <cmath>
 #include <stdexcept>
 
+#if defined(__AVX512F__)
+#include <immintrin.h>
+#endif
+
 namespace raypack {
 namespace {
 
@@ -104,6 +108,60 @@ std::uint32_t sobol1(std::uint32_t i) {
     return x;
 }
 
+#if defined(__AVX512F__) && defined(__AVX512DQ__) && defined(__AVX512VL__)
+// 64-bit lane operations in their zero-masked forms with a full mask: the
+// same instructions, without the undefined pass-through operand that makes
+// gcc 12 warn (-Wmaybe-uninitialized).
+constexpr __mmask8 kAll8 = 0xFF;
+__m512i srl64(__m512i v, unsigned s) { return _mm512_maskz_srli_epi64(kAll8, v, s); }
+__m512i mul64(__m512i a, __m512i b) { return _mm512_maskz_mullo_epi64(kAll8, a, b); }
+__m512i widen32(__m256i v) { return _mm512_maskz_cvtepu32_epi64(kAll8, v); }
+
+/// mix() in eight 64-bit lanes.
+__m512i mix8(__m512i h) {
+    h = mul64(_mm512_xor_si512(h, srl64(h, 30)), _mm512_set1_epi64(std::int64_t(0xBF58476D1CE4E5B9ull)));
+    h = mul64(_mm512_xor_si512(h, srl64(h, 27)), _mm512_set1_epi64(std::int64_t(0x94D049BB133111EBull)));
+    return _mm512_xor_si512(h, srl64(h, 31));
+}
+
+/// permute() in eight 32-bit lanes for a power-of-two n (no cycle walking:
+/// the masked value is already below n).
+__m256i permute8_pow2(__m256i i, std::uint32_t n, __m256i key) {
+    const __m256i w = _mm256_set1_epi32(int(n - 1));
+    auto mul = [](__m256i a, std::uint32_t c) { return _mm256_mullo_epi32(a, _mm256_set1_epi32(int(c))); };
+    auto fold = [&](__m256i a, int s) { return _mm256_xor_si256(a, _mm256_srli_epi32(_mm256_and_si256(a, w), s)); };
+    i = _mm256_xor_si256(i, key);
+    i = mul(i, 0xe170893du);
+    i = _mm256_xor_si256(i, _mm256_srli_epi32(key, 16));
+    i = fold(i, 4);
+    i = _mm256_xor_si256(i, _mm256_srli_epi32(key, 8));
+    i = mul(i, 0x0929eb3fu);
+    i = _mm256_xor_si256(i, _mm256_srli_epi32(key, 23));
+    i = fold(i, 1);
+    i = _mm256_mullo_epi32(i, _mm256_or_si256(_mm256_set1_epi32(1), _mm256_srli_epi32(key, 27)));
+    i = mul(i, 0x6935fa69u);
+    i = fold(i, 11);
+    i = mul(i, 0x74dcb303u);
+    i = fold(i, 2);
+    i = mul(i, 0x9e501cc3u);
+    i = fold(i, 2);
+    i = mul(i, 0xc860a3dfu);
+    i = _mm256_and_si256(i, w);
+    i = _mm256_xor_si256(i, _mm256_srli_epi32(i, 5));
+    return _mm256_and_si256(_mm256_add_epi32(i, key), w);
+}
+
+/// The low 32 bits of each 64-bit lane.
+__m256i low32(__m512i v) { return _mm512_maskz_cvtepi64_epi32(kAll8, v); }
+/// The high 32 bits of each 64-bit lane.
+__m256i high32(__m512i v) { return low32(srl64(v, 32)); }
+/// unit_float() in eight lanes.
+__m256 unit_float8(__m256i bits) {
+    return _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_srli_epi32(bits, 8)), _mm256_set1_ps(0x1.0p-24f));
+}
+#define RAYPACK_SAMPLER_LANES 1
+#endif
+
 }  // namespace
 
 std::optional<SamplerKind> sampler_from_name(std::string_view name) {
@@ -144,6 +202,56 @@ Sampler::Sampler(SamplerKind kind, int spp, std::uint64_t seed)
 
 Sampler::Pixel Sampler::pixel(std::uint64_t number) const {
     return {number, mix(seed_hash_ ^ (number + 0x9E3779B97F4A7C15ull * 2))};
+}
+
+void Sampler::get_many(std::span<const Draw> draws, int dimension, Sample2* out) const {
+    std::size_t j = 0;
+#if defined(RAYPACK_SAMPLER_LANES)
+    const bool pow2_strata = kind_ == SamplerKind::Stratified && log2_nx_ >= 0 && log2_ny_ >= 0;
+    if (pow2_strata || kind_ == SamplerKind::Random) {
+        const auto dim = std::uint64_t(dimension);
+        alignas(64) std::uint64_t hash[8];
+        alignas(32) std::int32_t index[8];
+        alignas(32) float x[8], y[8];
+        for (; j + 8 <= draws.size(); j += 8) {
+            for (int l = 0; l < 8; ++l) {
+                hash[l] = draws[j + std::size_t(l)].pixel.hash;
+                index[l] = draws[j + std::size_t(l)].index;
+            }
+            const __m512i h = _mm512_load_si512(hash);
+            const __m256i i = _mm256_load_si256(reinterpret_cast<const __m256i*>(index));
+            __m256 fx, fy;
+            if (kind_ == SamplerKind::Random) {
+                // hash_keys(pixel hash, dimension, 1 + 4 i)
+                const __m512i purpose = _mm512_add_epi64(_mm512_maskz_slli_epi64(kAll8, widen32(i), 2),
+                                                         _mm512_set1_epi64(std::int64_t(dim * 0x100000001B3ull + 2)));
+                const __m512i r = mix8(_mm512_xor_si512(h, purpose));
+                fx = unit_float8(low32(r));
+                fy = unit_float8(high32(r));
+            } else {
+                const __m512i key = mix8(_mm512_xor_si512(h, _mm512_set1_epi64(std::int64_t(dim * 0x100000001B3ull + 1))));
+                const __m256i cell = permute8_pow2(i, std::uint32_t(spp_), low32(key));
+                const __m512i jitter = mix8(_mm512_add_epi64(
+                    key, mul64(_mm512_set1_epi64(std::int64_t(0x9E3779B97F4A7C15ull)),
+                               _mm512_add_epi64(widen32(i), _mm512_set1_epi64(1)))));
+                const __m256i cx = _mm256_and_si256(cell, _mm256_set1_epi32(grid_.nx - 1));
+                const __m256i cy = _mm256_srlv_epi32(cell, _mm256_set1_epi32(log2_nx_));
+                const __m256 jx = _mm256_mul_ps(
+                    _mm256_cvtepi32_ps(_mm256_srlv_epi32(low32(jitter), _mm256_set1_epi32(8 + log2_nx_))),
+                    _mm256_set1_ps(jitter_unit_x_));
+                const __m256 jy = _mm256_mul_ps(
+                    _mm256_cvtepi32_ps(_mm256_srlv_epi32(high32(jitter), _mm256_set1_epi32(8 + log2_ny_))),
+                    _mm256_set1_ps(jitter_unit_y_));
+                fx = _mm256_mul_ps(_mm256_add_ps(_mm256_cvtepi32_ps(cx), jx), _mm256_set1_ps(float(inv_nx_)));
+                fy = _mm256_mul_ps(_mm256_add_ps(_mm256_cvtepi32_ps(cy), jy), _mm256_set1_ps(float(inv_ny_)));
+            }
+            _mm256_store_ps(x, fx);
+            _mm256_store_ps(y, fy);
+            for (int l = 0; l < 8; ++l) out[j + std::size_t(l)] = {x[l], y[l]};
+        }
+    }
+#endif
+    for (; j < draws.size(); ++j) out[j] = get(draws[j].pixel, draws[j].index, dimension);
 }
 
 Sample2 Sampler::get(const Pixel& pixel, int index, int dimension) const {

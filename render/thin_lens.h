@@ -27,17 +27,25 @@ inline Rayf thin_lens_ray(const CameraFrame& f, float px, float py, Sample2 lens
     return ray;
 }
 
+/// The camera ray of pixel (x, y) for the unit-square points `position`
+/// (sampler dimension 0, through the pixel filter) and `lens` (dimension 1;
+/// unused by a pinhole).
+inline Rayf camera_ray_of_sample(const CameraFrame& f, const Camera& camera, PixelFilter filter, Sample2 position,
+                                 Sample2 lens, int x, int y) {
+    const Sample2 off = filter_offset(filter, position);
+    return thin_lens_ray(f, float(x) + 0.5f + off.x, float(y) + 0.5f + off.y, lens, camera.lens_radius,
+                         camera.focus_distance);
+}
+
 /// Camera sample `index` of pixel (x, y) (number `pixel`) for the sampled
 /// integrators: its position drawn from the pixel filter (sampler dimension
 /// 0), its lens point from dimension 1.
 inline void sampled_camera_ray(const CameraFrame& f, const Camera& camera, const Sampler& sampler, PixelFilter filter,
                                const Sampler::Pixel& pixel, int x, int y, int index, Rayf& out) {
-    const Sample2 off = filter_offset(filter, sampler.get(pixel, index, 0));
     // A pinhole needs no lens point (the sampler is stateless: skipping the
     // draw changes no other sample).
     const Sample2 lens = camera.lens_radius > 0 ? sampler.get(pixel, index, 1) : Sample2{};
-    out = thin_lens_ray(f, float(x) + 0.5f + off.x, float(y) + 0.5f + off.y, lens, camera.lens_radius,
-                        camera.focus_distance);
+    out = camera_ray_of_sample(f, camera, filter, sampler.get(pixel, index, 0), lens, x, y);
 }
 
 }  // namespace raypack
