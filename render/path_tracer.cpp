@@ -119,6 +119,7 @@ public:
           options_(options),
           path_(path),
           offset_(options.offset, scene),
+          surfaces_(scene),
           samples_(options.sampler, options.spp, options.seed) {}
 
     const Sampler& samples() const { return samples_; }
@@ -147,6 +148,7 @@ private:
     const WhittedOptions& options_;
     const PathOptions& path_;
     RayOffset offset_;
+    SurfaceTable surfaces_;
     Sampler samples_;
 
     /// Dimensions of the bounce at `depth`: part choice and roulette, light
@@ -187,7 +189,7 @@ private:
             L += beta * scene_.background;
             return;
         }
-        const Surface surf = surface_at(scene_, ray, hit);
+        const Surface surf = surfaces_.at(ray, hit);
         const Material& m = scene_.materials[surf.material];
         const Vec3f wo = -normalize(ray.dir);
         const bool front = dot(wo, surf.geometric_normal) > 0;

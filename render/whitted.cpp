@@ -114,6 +114,7 @@ public:
           accel_(accel),
           options_(options),
           offset_(options.offset, scene),
+          surfaces_(scene),
           // SPD Readme: each light and the ambient term get sqrt(L) / (2 L),
           // L counting lights of every kind.
           intensity_(scene.spd_light_intensity()),
@@ -176,6 +177,7 @@ private:
     const Accel& accel_;
     const WhittedOptions& options_;
     RayOffset offset_;
+    SurfaceTable surfaces_;
     float intensity_ = 1;
     std::vector<float> specular_cutoff_;  ///< per material, see specular_cutoff
     Sampler samples_;        ///< camera samples: pixel position, lens, glossy lobes
@@ -217,7 +219,7 @@ private:
     /// (or the colour of the area light it lies on).
     void add_point(std::int32_t i, const Rayf& ray, const Hitf& hit, Scratch& s) const {
         RayTree& tree = s.tree;
-        const Surface surf = surface_at(scene_, ray, hit);
+        const Surface surf = surfaces_.at(ray, hit);
         const Material& m = scene_.materials[surf.material];
         if (m.area_light >= 0) {
             // A light's own surface shows the light's colour.
