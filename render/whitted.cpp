@@ -104,6 +104,11 @@ struct Scratch {
     ShadingPoints points;
     std::vector<SpawnPoint> spawn;
     std::vector<PixelXY> pixels;
+    std::vector<Sampler::Draw> draws;   ///< draws of one dimension for a batch (Sampler::get_many)
+    std::vector<Sample2> drawn, drawn_lens;
+    /// Points on area lights for one level: light a, point j, sample k at
+    /// (a * points + j) * light samples + k.
+    std::vector<Sample2> light_drawn;
     RenderStats stats;
 };
 
@@ -131,11 +136,31 @@ public:
         return scene_.lights.size() + scene_.distant_lights.size() + scene_.area_lights.size();
     }
 
-    /// Camera sample `index` of pixel (x, y) for distribution ray tracing:
-    /// its position drawn from the pixel filter, its lens point sampled.
-    void camera_sample(int x, int y, int index, Rayf& ray, const CameraFrame& frame) const {
-        const std::uint64_t pixel = std::uint64_t(y) * std::uint64_t(options_.width) + std::uint64_t(x);
-        sampled_camera_ray(frame, scene_.camera, samples_, options_.filter, samples_.pixel(pixel), x, y, index, ray);
+    /// Camera samples k0 .. k1 of every pixel of `pixels`, pixel by pixel, for
+    /// distribution ray tracing: positions drawn from the pixel filter
+    /// (sampler dimension 0) and lens points (dimension 1), all at once.
+    void camera_samples(std::span<const PixelXY> pixels, int k0, int k1, const CameraFrame& frame, Scratch& s) const {
+        s.draws.clear();
+        for (const PixelXY& px : pixels) {
+            const Sampler::Pixel pixel =
+                samples_.pixel(std::uint64_t(px.y) * std::uint64_t(options_.width) + std::uint64_t(px.x));
+            for (int k = k0; k < k1; ++k) s.draws.push_back({pixel, k});
+        }
+        s.drawn.resize(s.draws.size());
+        s.drawn_lens.assign(s.draws.size(), Sample2{});
+        samples_.get_many(s.draws, 0, s.drawn.data());
+        // A pinhole needs no lens point (skipping a draw changes no other).
+        if (scene_.camera.lens_radius > 0) samples_.get_many(s.draws, 1, s.drawn_lens.data());
+        const auto spp = std::uint64_t(samples_.spp());
+        std::size_t i = 0;
+        for (const PixelXY& px : pixels) {
+            const std::uint64_t pixel = std::uint64_t(px.y) * std::uint64_t(options_.width) + std::uint64_t(px.x);
+            for (int k = k0; k < k1; ++k, ++i) {
+                s.tree.rays[i] =
+                    camera_ray_of_sample(frame, scene_.camera, options_.filter, s.drawn[i], s.drawn_lens[i], px.x, px.y);
+                s.tree.sample[i] = pixel * spp + std::uint64_t(k);
+            }
+        }
     }
 
     /// The lens point of the sample with key `key` (sampler dimension 1).
@@ -208,8 +233,9 @@ private:
         for (std::size_t li = 0; li < scene_.lights.size(); ++li)
             stats.shadow_rays +=
                 shade_point_light(s.points, scene_.lights[li], intensity_, attenuation, offset_, s.shadows.per_light[li]);
+        if (!scene_.area_lights.empty()) draw_area_light_samples(depth, s);
         if (!scene_.distant_lights.empty() || !scene_.area_lights.empty())
-            for (std::size_t j = 0; j < s.points.size(); ++j) shade_other_lights(j, depth, s);
+            for (std::size_t j = 0; j < s.points.size(); ++j) shade_other_lights(j, s);
         if (depth < options_.max_depth)
             for (std::size_t j = 0; j < s.points.size(); ++j) spawn_children(j, depth, s);
         trace_shadows(s);
@@ -238,10 +264,23 @@ private:
         s.spawn.push_back({p, surf.material, front});
     }
 
+    /// The unit-square points of every area light's samples at every
+    /// shading point of the level, all at once (Sampler::get_many).
+    void draw_area_light_samples(int depth, Scratch& s) const {
+        const int n_light = light_samples_.spp();
+        s.draws.clear();
+        for (std::size_t j = 0; j < s.points.size(); ++j) {
+            const Sampler::Pixel key = light_samples_.pixel(s.tree.sample[std::size_t(s.points.ray(j))]);
+            for (int k = 0; k < n_light; ++k) s.draws.push_back({key, k});
+        }
+        s.light_drawn.resize(scene_.area_lights.size() * s.draws.size());
+        for (std::size_t a = 0; a < scene_.area_lights.size(); ++a)
+            light_samples_.get_many(s.draws, depth * 64 + int(a % 64), s.light_drawn.data() + a * s.draws.size());
+    }
+
     /// Distant and area lights at shading point j (point lights are done
     /// for all points at once by shade_point_light).
-    void shade_other_lights(std::size_t j, int depth, Scratch& s) const {
-        const RayTree& tree = s.tree;
+    void shade_other_lights(std::size_t j, Scratch& s) const {
         const ShadingPoints& pts = s.points;
         const std::int32_t i = pts.ray(j);
         const Material& m = scene_.materials[s.spawn[j].material];
@@ -268,7 +307,7 @@ private:
             const AreaLight& light = scene_.area_lights[a];
             const Vec3f share = light.color * (intensity_ / float(n_light));
             for (int k = 0; k < n_light; ++k) {
-                Sample2 u = light_samples_.get(tree.sample[std::size_t(i)], k, depth * 64 + int(a % 64));
+                Sample2 u = s.light_drawn[(a * pts.size() + j) * std::size_t(n_light) + std::size_t(k)];
                 if (!options_.distribution && light.shape == AreaLightShape::Sphere) u = {0, 0};  // the facing point
                 const LightSample ls = sample_area_light(light, above, u);
                 const Vec3f to_light = ls.point - above;
@@ -525,13 +564,7 @@ RenderStats render_whitted(const Scene& scene, const Accel& accel, const Whitted
                     s.tree.sample[i++] = std::uint64_t(px.y) * std::uint64_t(options.width) + std::uint64_t(px.x);
                 }
             } else {
-                for (const PixelXY& px : s.pixels) {
-                    const std::uint64_t pixel = std::uint64_t(px.y) * std::uint64_t(options.width) + std::uint64_t(px.x);
-                    for (int k = k0; k < k1; ++k, ++i) {
-                        tracer.camera_sample(px.x, px.y, k, s.tree.rays[i], frame);
-                        s.tree.sample[i] = pixel * std::uint64_t(spp) + std::uint64_t(k);
-                    }
-                }
+                tracer.camera_samples(s.pixels, k0, k1, frame, s);
             }
             tracer.trace(n, s);
             i = 0;
