@@ -37,15 +37,4 @@ inline Rayf camera_ray_of_sample(const CameraFrame& f, const Camera& camera, Pix
                          camera.focus_distance);
 }
 
-/// Camera sample `index` of pixel (x, y) (number `pixel`) for the sampled
-/// integrators: its position drawn from the pixel filter (sampler dimension
-/// 0), its lens point from dimension 1.
-inline void sampled_camera_ray(const CameraFrame& f, const Camera& camera, const Sampler& sampler, PixelFilter filter,
-                               const Sampler::Pixel& pixel, int x, int y, int index, Rayf& out) {
-    // A pinhole needs no lens point (the sampler is stateless: skipping the
-    // draw changes no other sample).
-    const Sample2 lens = camera.lens_radius > 0 ? sampler.get(pixel, index, 1) : Sample2{};
-    out = camera_ray_of_sample(f, camera, filter, sampler.get(pixel, index, 0), lens, x, y);
-}
-
 }  // namespace raypack
