@@ -59,7 +59,7 @@ struct PointLightLanes {
         alignas(64) float contribution[3][K], rv_lanes[K], specular[K];
         for (std::size_t j = 0; j < pts.count_; j += K) {
             const std::size_t left = pts.count_ - j;
-            const std::uint32_t in_range = left >= std::size_t(K) ? (K == 32 ? ~0u : (1u << K) - 1) : (1u << left) - 1;
+            const std::uint32_t in_range = left >= std::size_t(K) ? (1u << K) - 1 : (1u << left) - 1;
             const Vec3<F> above = load3(pts.above_, j);
             const Vec3<F> ns = load3(pts.ns_, j), ng = load3(pts.ng_, j), view = load3(pts.view_, j);
             // The recursive tracer's expressions, lane by lane (whitted.cpp).
