@@ -11,15 +11,13 @@ Vec3f triangle_normal(const TriangleSoA& t, std::uint32_t i) {
     return normalize(cross(t.p1[i] - t.p0[i], t.p2[i] - t.p0[i]));
 }
 
-/// The interpolated normal of triangle i at barycentrics (u, v), or the
-/// geometric normal `ng` where it vanishes, as surface_at computes it.
+}  // namespace
+
 Vec3f smooth_normal(const TriangleSoA& t, std::uint32_t i, const Hitf& hit, const Vec3f& ng) {
     const float w = 1.0f - hit.u - hit.v;
     const Vec3f n = t.n0[i] * w + t.n1[i] * hit.u + t.n2[i] * hit.v;
     return length(n) > 0 ? normalize(n) : ng;
 }
-
-}  // namespace
 
 Surface surface_at(const Scene& scene, const Rayf& ray, const Hitf& hit) {
     Surface s;
@@ -64,27 +62,6 @@ SurfaceTable::SurfaceTable(const Scene& scene) : scene_(scene), records_(scene.p
         }
         r.material_kind = scene.prim_material[p] << 2 | kind;
     }
-}
-
-Surface SurfaceTable::at(const Rayf& ray, const Hitf& hit) const {
-    const Record r = records_[hit.prim];
-    Surface s;
-    s.point = ray.org + ray.dir * hit.t;
-    s.material = r.material_kind >> 2;
-    switch (Kind(r.material_kind & 3)) {
-        case kFlatTriangle:
-            s.geometric_normal = s.shading_normal = r.v;
-            return s;
-        case kSmoothTriangle:
-            s.geometric_normal = r.v;
-            s.shading_normal = smooth_normal(scene_.triangles, scene_.prims[hit.prim].index, hit, r.v);
-            return s;
-        case kSphere:
-            s.geometric_normal = s.shading_normal = normalize(s.point - r.v);
-            return s;
-        case kOther: break;
-    }
-    return surface_at(scene_, ray, hit);
 }
 
 }  // namespace raypack

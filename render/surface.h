@@ -17,6 +17,10 @@ struct Surface {
 /// Surface at a found hit of `ray`.
 Surface surface_at(const Scene& scene, const Rayf& ray, const Hitf& hit);
 
+/// The interpolated normal of triangle i at the hit's barycentrics, or the
+/// geometric normal `ng` where it vanishes (surface_at's shading normal).
+Vec3f smooth_normal(const TriangleSoA& t, std::uint32_t i, const Hitf& hit, const Vec3f& ng);
+
 /// surface_at's answers, bit for bit, from one 16-byte record per primitive
 /// (a triangle's unit normal or a sphere's centre, with the material):
 /// hits of secondary rays land anywhere in the scene, and surface_at's reads
@@ -25,6 +29,8 @@ Surface surface_at(const Scene& scene, const Rayf& ray, const Hitf& hit);
 class SurfaceTable {
 public:
     explicit SurfaceTable(const Scene& scene);
+    /// Inline: out of line, the returned Surface went through the stack and
+    /// its copy stalled on store forwarding in the shading loops.
     Surface at(const Rayf& ray, const Hitf& hit) const;
 
 private:
@@ -37,5 +43,26 @@ private:
     const Scene& scene_;
     std::vector<Record> records_;
 };
+
+inline Surface SurfaceTable::at(const Rayf& ray, const Hitf& hit) const {
+    const Record r = records_[hit.prim];
+    Surface s;
+    s.point = ray.org + ray.dir * hit.t;
+    s.material = r.material_kind >> 2;
+    switch (Kind(r.material_kind & 3)) {
+        case kFlatTriangle:
+            s.geometric_normal = s.shading_normal = r.v;
+            return s;
+        case kSmoothTriangle:
+            s.geometric_normal = r.v;
+            s.shading_normal = smooth_normal(scene_.triangles, scene_.prims[hit.prim].index, hit, r.v);
+            return s;
+        case kSphere:
+            s.geometric_normal = s.shading_normal = normalize(s.point - r.v);
+            return s;
+        case kOther: break;
+    }
+    return surface_at(scene_, ray, hit);
+}
 
 }  // namespace raypack
