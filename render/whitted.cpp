@@ -241,6 +241,13 @@ private:
         trace_shadows(s);
     }
 
+    /// n, or -n unless `keep`, component by component: a whole-vector
+    /// select copied the Surface through the stack in 8-byte pieces that
+    /// stalled on the 4-byte stores that wrote it (store forwarding).
+    static Vec3f toward(const Vec3f& n, bool keep) {
+        return {keep ? n.x : -n.x, keep ? n.y : -n.y, keep ? n.z : -n.z};
+    }
+
     /// The hit's surface as a shading point, its ambient term as the colour
     /// (or the colour of the area light it lies on).
     void add_point(std::int32_t i, const Rayf& ray, const Hitf& hit, Scratch& s) const {
@@ -255,8 +262,8 @@ private:
         const Vec3f view = normalize(ray.dir);
         // Shade the side the ray arrives on: both normals face the viewer.
         const bool front = dot(view, surf.geometric_normal) < 0;
-        const Vec3f ng = front ? surf.geometric_normal : -surf.geometric_normal;
-        Vec3f ns = front ? surf.shading_normal : -surf.shading_normal;
+        const Vec3f ng = toward(surf.geometric_normal, front);
+        Vec3f ns = toward(surf.shading_normal, front);
         if (dot(ns, ng) < 0) ns = ng;  // interpolated normal bent past the surface
         const Vec3f p = offset_.hit_point(scene_, ray, hit, surf.point);
         tree.color[std::size_t(i)] = m.color * (intensity_ * m.kd);  // ambient
