@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "render/camera_rays.h"
+#include "render/camera_samples.h"
 #include "render/film.h"
 #include "render/light_sampling.h"
 #include "render/ray_offset.h"
@@ -96,8 +97,7 @@ using SampleKey = Sampler::Draw;
 
 struct Scratch {
     std::vector<PixelXY> pixels;
-    std::vector<SampleKey> keys;      ///< per sample of the tile
-    std::vector<Sample2> position, lens;  ///< camera samples' draws (dimensions 0 and 1)
+    CameraSampleBatch camera;  ///< the batch's camera samples; camera.keys: per sample of the batch
     /// The draws of one bounce for the paths that found a surface: what the
     /// path's sample draws in the bounce's four dimensions (choice and
     /// roulette, light, point on the light, direction), in bounce_draws[d]
@@ -163,7 +163,7 @@ private:
         s.draw_of.resize(p.rays.size());
         for (std::size_t i = 0; i < p.rays.size(); ++i) {
             s.draw_of[i] = p.hits[i].found() ? std::int32_t(s.bounce_keys.size()) : -1;
-            if (p.hits[i].found()) s.bounce_keys.push_back(s.keys[p.sample[i]]);
+            if (p.hits[i].found()) s.bounce_keys.push_back(s.camera.keys[p.sample[i]]);
         }
         const int dim = first_dimension(depth);
         for (int d = 0; d < 4; ++d) {
@@ -379,27 +379,11 @@ RenderStats render_path(const Scene& scene, const Accel& accel, const WhittedOpt
             const int k1 = std::min(spp, k0 + chunk);
             const std::size_t n = s.pixels.size() * std::size_t(k1 - k0);
             s.paths.start_camera_paths(n);
-            s.keys.resize(n);
             s.radiance.assign(n, Vec3f{});
-            std::size_t i = 0;
-            for (const PixelXY& px : s.pixels) {
-                const Sampler::Pixel pixel =
-                    tracer.samples().pixel(std::uint64_t(px.y) * std::uint64_t(options.width) + std::uint64_t(px.x));
-                for (int k = k0; k < k1; ++k, ++i) s.keys[i] = {pixel, k};
-            }
-            // The camera samples' draws all at once, then their rays. A
-            // pinhole needs no lens point (skipping a draw changes no other).
-            s.position.resize(n);
-            s.lens.assign(n, Sample2{});
-            tracer.samples().get_many(s.keys, 0, s.position.data());
-            if (scene.camera.lens_radius > 0) tracer.samples().get_many(s.keys, 1, s.lens.data());
-            i = 0;
-            for (const PixelXY& px : s.pixels)
-                for (int k = k0; k < k1; ++k, ++i)
-                    s.paths.rays[i] =
-                        camera_ray_of_sample(frame, scene.camera, options.filter, s.position[i], s.lens[i], px.x, px.y);
+            s.camera.draw(frame, scene.camera, tracer.samples(), options.filter, s.pixels, options.width, k0, k1,
+                          s.paths.rays.data());
             tracer.trace(s);
-            i = 0;
+            std::size_t i = 0;
             for (const PixelXY& px : s.pixels) {
                 film.add(px.x, px.y, std::span(s.radiance).subspan(i, std::size_t(k1 - k0)));
                 i += std::size_t(k1 - k0);

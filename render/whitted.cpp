@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "render/camera_rays.h"
+#include "render/camera_samples.h"
 #include "render/light_sampling.h"
 #include "render/sampling.h"
 #include "render/shading_points.h"
@@ -104,8 +105,8 @@ struct Scratch {
     ShadingPoints points;
     std::vector<SpawnPoint> spawn;
     std::vector<PixelXY> pixels;
-    std::vector<Sampler::Draw> draws;   ///< draws of one dimension for a batch (Sampler::get_many)
-    std::vector<Sample2> drawn, drawn_lens;
+    CameraSampleBatch camera;           ///< distribution: the batch's camera samples
+    std::vector<Sampler::Draw> draws;   ///< points on area lights: the level's draws (Sampler::get_many)
     /// Points on area lights for one level: light a, point j, sample k at
     /// (a * points + j) * light samples + k.
     std::vector<Sample2> light_drawn;
@@ -140,26 +141,12 @@ public:
     /// distribution ray tracing: positions drawn from the pixel filter
     /// (sampler dimension 0) and lens points (dimension 1), all at once.
     void camera_samples(std::span<const PixelXY> pixels, int k0, int k1, const CameraFrame& frame, Scratch& s) const {
-        s.draws.clear();
-        for (const PixelXY& px : pixels) {
-            const Sampler::Pixel pixel =
-                samples_.pixel(std::uint64_t(px.y) * std::uint64_t(options_.width) + std::uint64_t(px.x));
-            for (int k = k0; k < k1; ++k) s.draws.push_back({pixel, k});
-        }
-        s.drawn.resize(s.draws.size());
-        s.drawn_lens.assign(s.draws.size(), Sample2{});
-        samples_.get_many(s.draws, 0, s.drawn.data());
-        // A pinhole needs no lens point (skipping a draw changes no other).
-        if (scene_.camera.lens_radius > 0) samples_.get_many(s.draws, 1, s.drawn_lens.data());
+        s.camera.draw(frame, scene_.camera, samples_, options_.filter, pixels, options_.width, k0, k1, s.tree.rays.data());
         const auto spp = std::uint64_t(samples_.spp());
         std::size_t i = 0;
         for (const PixelXY& px : pixels) {
             const std::uint64_t pixel = std::uint64_t(px.y) * std::uint64_t(options_.width) + std::uint64_t(px.x);
-            for (int k = k0; k < k1; ++k, ++i) {
-                s.tree.rays[i] =
-                    camera_ray_of_sample(frame, scene_.camera, options_.filter, s.drawn[i], s.drawn_lens[i], px.x, px.y);
-                s.tree.sample[i] = pixel * spp + std::uint64_t(k);
-            }
+            for (int k = k0; k < k1; ++k, ++i) s.tree.sample[i] = pixel * spp + std::uint64_t(k);
         }
     }
 

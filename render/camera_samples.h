@@ -1,0 +1,40 @@
+#pragma once
+// The camera samples of a batch of pixels for the sampled integrators
+// (distribution and path tracing): every draw of the batch at once
+// (Sampler::get_many), then the rays.
+#include <span>
+#include <vector>
+
+#include "render/thin_lens.h"
+#include "render/tiles.h"
+
+namespace raypack {
+
+struct CameraSampleBatch {
+    std::vector<Sampler::Draw> keys;  ///< per sample, pixel by pixel: samples k0 .. k1 of each
+    std::vector<Sample2> position, lens;
+
+    /// Samples k0 .. k1 of every pixel of `pixels` (numbered y * width + x):
+    /// their keys, and their rays in rays[0 .. pixels * (k1 - k0)). Positions
+    /// come from sampler dimension 0 through the pixel filter, lens points
+    /// from dimension 1; a pinhole draws none (skipping a draw changes no
+    /// other).
+    void draw(const CameraFrame& frame, const Camera& camera, const Sampler& sampler, PixelFilter filter,
+              std::span<const PixelXY> pixels, int width, int k0, int k1, Rayf* rays) {
+        keys.clear();
+        for (const PixelXY& px : pixels) {
+            const Sampler::Pixel pixel = sampler.pixel(std::uint64_t(px.y) * std::uint64_t(width) + std::uint64_t(px.x));
+            for (int k = k0; k < k1; ++k) keys.push_back({pixel, k});
+        }
+        position.resize(keys.size());
+        lens.assign(keys.size(), Sample2{});
+        sampler.get_many(keys, 0, position.data());
+        if (camera.lens_radius > 0) sampler.get_many(keys, 1, lens.data());
+        std::size_t i = 0;
+        for (const PixelXY& px : pixels)
+            for (int k = k0; k < k1; ++k, ++i)
+                rays[i] = camera_ray_of_sample(frame, camera, filter, position[i], lens[i], px.x, px.y);
+    }
+};
+
+}  // namespace raypack
