@@ -7,6 +7,7 @@
 
 #include "kernels/aabb.h"
 #include "kernels/ray.h"
+#include "kernels/ray_transpose.h"
 #include "kernels/simd.h"
 
 namespace raypack {
@@ -37,9 +38,32 @@ template <int K> using HitPacket = HitLanes<vfloat<K>>;
 template <int K>
 RayPacket<K> load_packet(std::span<const Rayf> rays, vmask<K>& valid, RcpMethod rcp = RcpMethod::Exact) {
     using F = vfloat<K>;
+    const std::size_t n = rays.size();
+#if defined(__AVX2__)
+    if constexpr (K == 8 || K == 16) {
+        // A full packet moves as 8 x 8 transposes (kernels/ray_transpose.h).
+        if (n == std::size_t(K) && rcp == RcpMethod::Exact) {
+            __m256 row[2][8];
+            for (int h = 0; h < K / 8; ++h) transpose_rays8(rays.data() + 8 * h, row[h]);
+            auto field = [&](int f) -> F {
+                if constexpr (K == 8) return F(row[0][f]);
+#if defined(__AVX512F__)
+                else return F(_mm512_insertf32x8(_mm512_castps256_ps512(row[0][f]), row[1][f], 1));
+#endif
+            };
+            RayPacket<K> p;
+            p.org = {field(0), field(1), field(2)};
+            p.dir = {field(3), field(4), field(5)};
+            p.tnear = field(6);
+            p.tfar = field(7);
+            p.rdir = reciprocal(p.dir);
+            valid = F(1.0f) > F(0.0f);
+            return p;
+        }
+    }
+#endif
     alignas(64) float f[8][K];
     alignas(64) float active[K];
-    const std::size_t n = rays.size();
     for (int i = 0; i < K; ++i) {
         const Rayf& r = rays[std::min<std::size_t>(std::size_t(i), n - 1)];
         const float vals[8] = {r.org.x, r.org.y, r.org.z, r.dir.x, r.dir.y, r.dir.z, r.tnear, r.tfar};

@@ -13,6 +13,7 @@
 #include <embree3/rtcore.h>
 
 #include "kernels/ray.h"
+#include "kernels/ray_transpose.h"
 
 namespace raypack::embree_io {
 
@@ -42,31 +43,6 @@ void set_lane(RayK& ray, int i, const Rayf& r) {
 }
 
 #if defined(__AVX2__)
-static_assert(sizeof(Rayf) == 32, "a Rayf must be eight floats for the transposed load");
-
-/// Rows of 8 rays (org.x, org.y, org.z, dir.x, dir.y, dir.z, tnear, tfar),
-/// transposed: row[f][i] is field f of ray i.
-inline void transpose8(const Rayf* rays, __m256 (&row)[8]) {
-    __m256 r[8];
-    for (int i = 0; i < 8; ++i) r[i] = _mm256_loadu_ps(reinterpret_cast<const float*>(rays + i));
-    const __m256 t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpackhi_ps(r[0], r[1]);
-    const __m256 t2 = _mm256_unpacklo_ps(r[2], r[3]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
-    const __m256 t4 = _mm256_unpacklo_ps(r[4], r[5]), t5 = _mm256_unpackhi_ps(r[4], r[5]);
-    const __m256 t6 = _mm256_unpacklo_ps(r[6], r[7]), t7 = _mm256_unpackhi_ps(r[6], r[7]);
-    const __m256 s0 = _mm256_shuffle_ps(t0, t2, 0x44), s1 = _mm256_shuffle_ps(t0, t2, 0xEE);
-    const __m256 s2 = _mm256_shuffle_ps(t1, t3, 0x44), s3 = _mm256_shuffle_ps(t1, t3, 0xEE);
-    const __m256 s4 = _mm256_shuffle_ps(t4, t6, 0x44), s5 = _mm256_shuffle_ps(t4, t6, 0xEE);
-    const __m256 s6 = _mm256_shuffle_ps(t5, t7, 0x44), s7 = _mm256_shuffle_ps(t5, t7, 0xEE);
-    row[0] = _mm256_permute2f128_ps(s0, s4, 0x20);
-    row[1] = _mm256_permute2f128_ps(s1, s5, 0x20);
-    row[2] = _mm256_permute2f128_ps(s2, s6, 0x20);
-    row[3] = _mm256_permute2f128_ps(s3, s7, 0x20);
-    row[4] = _mm256_permute2f128_ps(s0, s4, 0x31);
-    row[5] = _mm256_permute2f128_ps(s1, s5, 0x31);
-    row[6] = _mm256_permute2f128_ps(s2, s6, 0x31);
-    row[7] = _mm256_permute2f128_ps(s3, s7, 0x31);
-}
-
 /// Whether all 8 rays of `row` start at `origin` (lane 0 of the packet).
 inline bool same_origin8(const __m256 (&row)[8], const Rayf& first) {
     const int eq = _mm256_movemask_ps(_mm256_cmp_ps(row[0], _mm256_set1_ps(first.org.x), _CMP_EQ_OQ)) &
@@ -79,7 +55,7 @@ inline bool same_origin8(const __m256 (&row)[8], const Rayf& first) {
 template <class RayK>
 bool load8(const Rayf* rays, RayK& ray, int offset) {
     __m256 row[8];
-    transpose8(rays, row);
+    transpose_rays8(rays, row);
     _mm256_storeu_ps(ray.org_x + offset, row[0]);
     _mm256_storeu_ps(ray.org_y + offset, row[1]);
     _mm256_storeu_ps(ray.org_z + offset, row[2]);
@@ -149,18 +125,7 @@ void store_hits(const RayHitK& rh, int n, const std::uint32_t* base, bool consec
             const __m256 p = _mm256_blendv_ps(_mm256_castsi256_ps(prim), _mm256_castsi256_ps(invalid), miss);
             const __m256 u = _mm256_andnot_ps(miss, _mm256_loadu_ps(rh.hit.u + h));
             const __m256 v = _mm256_andnot_ps(miss, _mm256_loadu_ps(rh.hit.v + h));
-            // 4 rows of 8 into 8 hits of (t, prim, u, v).
-            const __m256 a = _mm256_unpacklo_ps(t, p), b = _mm256_unpackhi_ps(t, p);
-            const __m256 c = _mm256_unpacklo_ps(u, v), d = _mm256_unpackhi_ps(u, v);
-            const __m256 e = _mm256_castpd_ps(_mm256_unpacklo_pd(_mm256_castps_pd(a), _mm256_castps_pd(c)));
-            const __m256 f = _mm256_castpd_ps(_mm256_unpackhi_pd(_mm256_castps_pd(a), _mm256_castps_pd(c)));
-            const __m256 g = _mm256_castpd_ps(_mm256_unpacklo_pd(_mm256_castps_pd(b), _mm256_castps_pd(d)));
-            const __m256 k = _mm256_castpd_ps(_mm256_unpackhi_pd(_mm256_castps_pd(b), _mm256_castps_pd(d)));
-            float* out = reinterpret_cast<float*>(hits + h);
-            _mm256_storeu_ps(out, _mm256_permute2f128_ps(e, f, 0x20));
-            _mm256_storeu_ps(out + 8, _mm256_permute2f128_ps(g, k, 0x20));
-            _mm256_storeu_ps(out + 16, _mm256_permute2f128_ps(e, f, 0x31));
-            _mm256_storeu_ps(out + 24, _mm256_permute2f128_ps(g, k, 0x31));
+            store_hits8(t, p, u, v, hits + h);
         }
         return;
     }
