@@ -70,13 +70,13 @@ struct PacketNodeRay {
 template <int K>
 RAYPACK_INLINE PacketNodeRay<K> make_packet_node_ray(const RayPacket<K>& p, SlabMethod slabs) {
     using F = vfloat<K>;
-    const F inf(std::numeric_limits<float>::infinity());
+    F inf(std::numeric_limits<float>::infinity());
     PacketNodeRay<K> n;
     const bool widen = slabs == SlabMethod::Robust;
     auto axis = [&](const F& d, const F& rd, F& r, F& r_far, vmask<K>& negative) {
         r = select(vabs(d) < F(kMinRcpInput), copysign_of(inf, d), rd);
         if (widen) {
-            const F w = r * F(kFarWiden);
+            F w = r * F(kFarWiden);
             r_far = select(vabs(w) == inf, w, next_away_from_zero(w));
         } else {
             r_far = r;
@@ -113,16 +113,16 @@ template <int N, int K>
 RAYPACK_INLINE vmask<K> child_hits(const WideNode<N>& node, int i, const PacketNodeRay<K>& r, const vmask<K>& active,
                                    const vfloat<K>& tfar, vfloat<K>& entry) {
     using F = vfloat<K>;
-    const F lx(node.bounds[0][i]), ly(node.bounds[1][i]), lz(node.bounds[2][i]);
-    const F hx(node.bounds[3][i]), hy(node.bounds[4][i]), hz(node.bounds[5][i]);
-    const F nx = (select(r.neg_x, hx, lx) - r.org.x) * r.rdir.x;
-    const F ny = (select(r.neg_y, hy, ly) - r.org.y) * r.rdir.y;
-    const F nz = (select(r.neg_z, hz, lz) - r.org.z) * r.rdir.z;
-    const F fx = (select(r.neg_x, lx, hx) - r.org.x) * r.rdir_far.x;
-    const F fy = (select(r.neg_y, ly, hy) - r.org.y) * r.rdir_far.y;
-    const F fz = (select(r.neg_z, lz, hz) - r.org.z) * r.rdir_far.z;
+    F lx(node.bounds[0][i]), ly(node.bounds[1][i]), lz(node.bounds[2][i]);
+    F hx(node.bounds[3][i]), hy(node.bounds[4][i]), hz(node.bounds[5][i]);
+    F nx = (select(r.neg_x, hx, lx) - r.org.x) * r.rdir.x;
+    F ny = (select(r.neg_y, hy, ly) - r.org.y) * r.rdir.y;
+    F nz = (select(r.neg_z, hz, lz) - r.org.z) * r.rdir.z;
+    F fx = (select(r.neg_x, lx, hx) - r.org.x) * r.rdir_far.x;
+    F fy = (select(r.neg_y, ly, hy) - r.org.y) * r.rdir_far.y;
+    F fz = (select(r.neg_z, lz, hz) - r.org.z) * r.rdir_far.z;
     entry = vmax(vmax(nx, ny), vmax(nz, r.tnear));
-    const F exit = vmin(vmin(fx, fy), vmin(fz, tfar));
+    F exit = vmin(vmin(fx, fy), vmin(fz, tfar));
     return active & (entry <= exit);
 }
 
@@ -131,11 +131,11 @@ RAYPACK_INLINE vmask<K> child_hits(const WideNode<N>& node, int i, const PacketN
 template <TriangleMethod TM, class F, int M>
 RAYPACK_INLINE mask_of<F> intersect_one(const TriangleBlock<M>& b, int j, SphereMethod, const LeafRay<F>& r,
                                         const mask_of<F>& active, const F& tfar, F& t, F& u, F& v) {
-    const Vec3<F> p0{F(b.p0[0][j]), F(b.p0[1][j]), F(b.p0[2][j])};
-    const Vec3<F> a{F(b.a[0][j]), F(b.a[1][j]), F(b.a[2][j])};
-    const Vec3<F> c{F(b.b[0][j]), F(b.b[1][j]), F(b.b[2][j])};
+    Vec3<F> p0{F(b.p0[0][j]), F(b.p0[1][j]), F(b.p0[2][j])};
+    Vec3<F> a{F(b.a[0][j]), F(b.a[1][j]), F(b.a[2][j])};
+    Vec3<F> c{F(b.b[0][j]), F(b.b[1][j]), F(b.b[2][j])};
     if constexpr (TM == TriangleMethod::Moeller) {
-        const Vec3<F> ng{F(b.ng[0][j]), F(b.ng[1][j]), F(b.ng[2][j])};
+        Vec3<F> ng{F(b.ng[0][j]), F(b.ng[1][j]), F(b.ng[2][j])};
         return intersect_triangle_moeller_edges<F>(active, r.org, r.dir, r.tnear, tfar, p0, a, c, ng, t, u, v);
     } else if constexpr (TM == TriangleMethod::Watertight) {
         return intersect_triangle_watertight<F>(active, r.watertight, r.tnear, tfar, p0, a, c, t, u, v);
@@ -148,8 +148,8 @@ template <TriangleMethod TM, class F, int M>
 RAYPACK_INLINE mask_of<F> intersect_one(const SphereBlock<M>& b, int j, SphereMethod method, const LeafRay<F>& r,
                                         const mask_of<F>& active, const F& tfar, F& t, F& u, F& v) {
     const QuadricRay<F> q{r.org, r.dir, r.tnear, tfar, r.dd, r.inv_dd};
-    const Vec3<F> c{F(b.center[0][j]), F(b.center[1][j]), F(b.center[2][j])};
-    const F radius(b.radius[j]);
+    Vec3<F> c{F(b.center[0][j]), F(b.center[1][j]), F(b.center[2][j])};
+    F radius(b.radius[j]);
     u = v = F(0.0f);
     switch (method) {
         case SphereMethod::Algebraic: return intersect_sphere<SphereMethod::Algebraic, F>(active, q, c, radius, t);
@@ -194,11 +194,11 @@ RAYPACK_INLINE void packet_run(const Block* b, std::uint32_t count, SphereMethod
                                vmask<K> active, PacketState<K>& s) {
     using F = vfloat<K>;
     constexpr int M = int(sizeof(b->prim) / sizeof(b->prim[0]));
-    const F minus_inf(-std::numeric_limits<float>::infinity());
+    F minus_inf(-std::numeric_limits<float>::infinity());
     for (; count != 0; --count, ++b) {
         for (int j = 0; j < M && b->prim[j] != kNoPrim; ++j) {
             F t(0.0f), u(0.0f), v(0.0f);  // the kernels set only their hit lanes
-            const vmask<K> m = intersect_one<TM, F, M>(*b, j, sm, r, active, s.tfar, t, u, v);
+            vmask<K> m = intersect_one<TM, F, M>(*b, j, sm, r, active, s.tfar, t, u, v);
             if (none(m)) continue;
             if constexpr (AnyHit) {
                 s.occluded = s.occluded | m;
@@ -241,7 +241,7 @@ template <bool AnyHit, int N, int M, int K>
 inline void packet_leaf_by_prim(const WideBvh<N, M>& bvh, const PacketPrimitiveIntersector<vfloat<K>>& isect,
                                 std::uint32_t code, const RayPacket<K>& ray, vmask<K> active, PacketState<K>& s) {
     using F = vfloat<K>;
-    const F minus_inf(-std::numeric_limits<float>::infinity());
+    F minus_inf(-std::numeric_limits<float>::infinity());
     RayPacket<K> r = ray;
     auto run = [&](const auto* b, std::uint32_t count) {
         constexpr int BM = int(sizeof(b->prim) / sizeof(b->prim[0]));
@@ -249,7 +249,7 @@ inline void packet_leaf_by_prim(const WideBvh<N, M>& bvh, const PacketPrimitiveI
             for (int j = 0; j < BM && b->prim[j] != kNoPrim; ++j) {
                 if (none(active)) return;
                 r.tfar = s.tfar;
-                const vmask<K> m = isect.intersect(active, r, s.hit, b->prim[j]);
+                vmask<K> m = isect.intersect(active, r, s.hit, b->prim[j]);
                 if constexpr (AnyHit) {
                     s.occluded = s.occluded | m;
                     s.valid = s.valid & !m;
@@ -342,7 +342,7 @@ void lanes_alone(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, std::uint
     s.tfar = F::load_aligned(tfar);
     if constexpr (AnyHit) {
         if (occluded != 0) {
-            const vmask<K> m = mask_from_bits<K>(occluded);
+            vmask<K> m = mask_from_bits<K>(occluded);
             s.occluded = s.occluded | m;
             s.valid = s.valid & !m;
         }
@@ -364,7 +364,7 @@ void trace_packet(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, int swit
     const LeafRay<F> lr = make_packet_leaf_ray<K>(ray, TM);
     PacketState<K> s{hit, ray.tfar, valid, occluded};
     const WideNode<N>* nodes = bvh.nodes.data();
-    const F nan(std::numeric_limits<float>::quiet_NaN());
+    F nan(std::numeric_limits<float>::quiet_NaN());
     // Stack entries: a child and its lanes' entry distances, NaN in the
     // lanes that missed it, so that `entry <= tfar` at the pop is exactly
     // the lanes that meet it before their closest hit so far.
@@ -393,11 +393,11 @@ void trace_packet(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, int swit
             std::uint32_t child[N];
             float key[N];
             int count = 0;
-            const F tfar_nodes = node_tfar(s.tfar);
+            F tfar_nodes = node_tfar(s.tfar);
             for (int i = 0; i < N; ++i) {
                 if (node.child[i] == wide_child::kEmpty) continue;
                 F e;
-                const B m = child_hits<N, K>(node, i, nr, active, tfar_nodes, e);
+                B m = child_hits<N, K>(node, i, nr, active, tfar_nodes, e);
                 const std::uint32_t mb = mask_bits(m);
                 if (mb == 0) continue;
                 select(m, e, nan).store_aligned(entry[count]);
@@ -420,7 +420,7 @@ void trace_packet(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, int swit
                 std::copy(entry[order[c]], entry[order[c]] + K, stack_entry[sp]);
                 stack_node[sp++] = child[order[c]];
             }
-            const F e0 = F::load_aligned(entry[order[0]]);
+            F e0 = F::load_aligned(entry[order[0]]);
             active = e0 == e0;  // not NaN: the lanes that met it
             cur = child[order[0]];
         }
