@@ -53,6 +53,8 @@ Scene load_generated(const std::string& spec) {
         if (variants) text = apply_scene_variants(text, *variants);
     } catch (const std::invalid_argument& e) {
         throw SceneError(spec, 0, std::string("bad generator spec: ") + e.what());
+    } catch (const std::runtime_error& e) {  // too large for the memory available
+        throw SceneError(spec, 0, e.what());
     }
     return load_nff_text(text, spec);
 }

@@ -18,11 +18,15 @@ constexpr double kCornerX = -1.0;
 constexpr double kCornerY = -1.0;
 constexpr double kWidth = 2.0;
 
-/// The 1987 seed hash of grid point (a, b) at size factor c (c <= 7).
+/// The 1987 seed hash of grid point (a, b) at size factor c. It was written
+/// for c <= 7; above, where its last term would shift by a negative count,
+/// that term shifts right by c - 7 instead (the same bits of a, moved the
+/// other way), and c <= 15 keeps the others defined.
 unsigned long original_hash(int a, int b, int c) {
     const auto ua = static_cast<unsigned long>(a);
     const auto ub = static_cast<unsigned long>(b);
-    return ((ua << (23 - c)) + (ub << (15 - c)) + (ua << (7 - c))) & 0xffffUL;
+    const unsigned long low = c <= 7 ? ua << (7 - c) : ua >> (c - 7);
+    return ((ua << (23 - c)) + (ub << (15 - c)) + low) & 0xffffUL;
 }
 
 /// Gaussian deviate from a seed: Numerical Recipes' GASDEV (polar

@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "scene/memory_budget.h"
 #include "scene/spd/generators.h"
 
 namespace raypack {
@@ -14,23 +15,38 @@ namespace {
 struct Entry {
     const char* name;
     int default_size;
-    int max_size;
+    int limit;  ///< the generator's own largest size (its arithmetic), or 0
     std::string (*generate)(int size);
+    double (*primitives)(int size);  ///< primitives as loaded (polygons as triangles)
 };
 
+double power(double base, int exponent) {
+    double p = 1.0;
+    for (int i = 0; i < exponent; ++i) p *= base;
+    return p;
+}
+
 // Default size factors as in SPD 3.14. SPD itself has no upper bound; ours
-// keep a scene under about a million primitives, and mount stops at 7
-// because its original hash shifts by (7 - size) bits.
+// is what raypack's structures address (kMaxPrimitives) and what fits in
+// memory (generate_spd). mount stops at 15: its original hash shifts by
+// (15 - size) bits.
 constexpr Entry kGenerators[] = {
-    {"balls", 4, 6, spd::generate_balls},
-    {"tetra", 6, 9, spd::generate_tetra},
-    {"mount", 6, 7, spd::generate_mount},
-    {"rings", 7, 20, spd::generate_rings},
-    {"tree", 11, 18, spd::generate_tree},
-    {"gears", 4, 12, spd::generate_gears},
-    {"teapot", 6, 64, spd::generate_teapot},
-    {"cornell", 1, 2, spd::generate_cornell},
+    {"balls", 4, 0, spd::generate_balls, [](int n) { return (power(9, n + 1) - 1.0) / 8.0 + 2.0; }},
+    {"tetra", 6, 0, spd::generate_tetra, [](int n) { return power(4, n); }},
+    {"mount", 6, 15, spd::generate_mount, [](int n) { return 2.0 * power(4, n) + 4.0; }},
+    {"rings", 7, 0, spd::generate_rings, [](int n) { return 10.0 * n * (n + 1.0) * (2.0 * n + 1.0) + 2.0; }},
+    {"tree", 11, 0, spd::generate_tree, [](int n) { return 2.0 * (power(2, n + 1) - 1.0) + 2.0; }},
+    {"gears", 4, 0, spd::generate_gears, [](int n) { return 572.0 * n * n * n + 2.0; }},
+    {"teapot", 6, 0, spd::generate_teapot, [](int n) { return 66.0 * n * n - 8.0 * n; }},
+    {"cornell", 1, 2, spd::generate_cornell, [](int n) { return n == 1 ? 32.0 : 14.0; }},
 };
+
+/// The largest size whose scene raypack can address.
+int max_size(const Entry& e) {
+    int size = 1;
+    while ((e.limit == 0 || size < e.limit) && e.primitives(size + 1) <= double(kMaxSpdPrimitives)) ++size;
+    return size;
+}
 
 std::string valid_names() {
     std::string out;
@@ -45,16 +61,30 @@ std::string valid_names() {
 
 std::vector<SpdGeneratorInfo> spd_generators() {
     std::vector<SpdGeneratorInfo> out;
-    for (const Entry& e : kGenerators) out.push_back({e.name, e.default_size, e.max_size});
+    for (const Entry& e : kGenerators) out.push_back({e.name, e.default_size, max_size(e)});
     return out;
+}
+
+std::uint64_t spd_primitives(std::string_view name, int size) {
+    for (const Entry& e : kGenerators)
+        if (name == e.name && size >= 1 && size <= max_size(e)) return std::uint64_t(e.primitives(size));
+    return 0;
 }
 
 std::string generate_spd(std::string_view name, int size) {
     for (const Entry& e : kGenerators) {
         if (name != e.name) continue;
-        if (size < 1 || size > e.max_size)
+        if (size < 1 || size > max_size(e))
             throw std::invalid_argument("generate_spd: size " + std::to_string(size) + " out of range 1.." +
-                                        std::to_string(e.max_size) + " for '" + std::string(name) + "'");
+                                        std::to_string(max_size(e)) + " for '" + std::string(name) + "'" +
+                                        (size > 1 && e.limit == 0 ? " (larger sizes exceed " +
+                                                                        std::to_string(kMaxSpdPrimitives) +
+                                                                        " primitives)"
+                                                                  : ""));
+        const auto prims = std::uint64_t(e.primitives(size));
+        require_memory(prims * kSpdBytesPerPrimitive,
+                       std::string(name) + " size " + std::to_string(size) + " (" + std::to_string(prims) +
+                           " primitives)");
         return e.generate(size);
     }
     throw std::invalid_argument("generate_spd: unknown SPD generator '" + std::string(name) +
