@@ -13,6 +13,9 @@ scene and ray kind; the table gives medians over the rounds (docs/embree.md).
 
 usage: scripts/embree_check.py [--rounds N] [--res N] [--repeat R] [--build DIR]
                                [--scenes a,b] [--kinds camera,shadow,diffuse]
+
+--scenes takes the names below or any scene raypack loads (a file or
+gen:NAME:SIZE), e.g. --scenes gen:tetra:10 for a million triangles.
 """
 import argparse
 import json
@@ -77,23 +80,23 @@ def main():
     scenes = args.scenes.split(",")
     kinds = args.kinds.split(",")
     for s in scenes:
-        if s not in SCENES:
+        if s not in SCENES and not os.path.exists(s) and not s.startswith("gen:"):
             sys.exit(f"embree_check: unknown scene '{s}' (expected {', '.join(SCENES)})")
     results = {}
     with tempfile.TemporaryDirectory() as tmp:
         files = {}
         for s in scenes:
             for k in kinds:
-                files[s, k] = os.path.join(tmp, f"{s}-{k}.rays")
-                run([os.path.join(args.build, "raypack"), "rays", SCENES[s], "--kind", k, "--res", str(args.res),
+                files[s, k] = os.path.join(tmp, f"{os.path.basename(s).replace(':', '_')}-{k}.rays")
+                run([os.path.join(args.build, "raypack"), "rays", SCENES.get(s, s), "--kind", k, "--res", str(args.res),
                      str(args.res), "-o", files[s, k]])
         for r in range(args.rounds):
             for s in scenes:
                 for k in kinds:
                     cell = results.setdefault((s, k), {"direct": [], "backend": [], "default": []})
-                    d = direct_best(args.build, SCENES[s], files[s, k], args.repeat)
-                    b = backend_best(args.build, SCENES[s], files[s, k], args.repeat, os.path.join(tmp, "b.json"))
-                    f = default_config(args.build, SCENES[s], files[s, k], args.repeat)
+                    d = direct_best(args.build, SCENES.get(s, s), files[s, k], args.repeat)
+                    b = backend_best(args.build, SCENES.get(s, s), files[s, k], args.repeat, os.path.join(tmp, "b.json"))
+                    f = default_config(args.build, SCENES.get(s, s), files[s, k], args.repeat)
                     cell["direct"].append(d)
                     cell["backend"].append(b)
                     cell["default"].append(f)

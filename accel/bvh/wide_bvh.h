@@ -6,9 +6,9 @@
 // RT 2008; Wald, Benthin, Boulos, "Getting Rid of Packets", RT 2008). Leaves
 // are runs of SoA blocks of M primitives of one kind (accel/bvh/leaf_blocks.h).
 #include <cstdint>
+#include <new>
 #include <vector>
 
-#include <xsimd/memory/xsimd_aligned_allocator.hpp>
 
 #include "accel/bvh/leaf_blocks.h"
 #include "kernels/aabb.h"
@@ -62,8 +62,23 @@ struct MixedLeaf {
     std::uint32_t count[3];
 };  // total: 24 bytes
 
+/// Cache-line aligned storage through the aligned global `operator new`
+/// (which raypack's command line replaces to ask for huge pages for large
+/// blocks, app/heap_pages.cpp).
 template <class T>
-using AlignedVector = std::vector<T, xsimd::aligned_allocator<T, 64>>;
+struct CacheLineAllocator {
+    using value_type = T;
+    CacheLineAllocator() = default;
+    template <class U>
+    CacheLineAllocator(const CacheLineAllocator<U>&) {}
+    T* allocate(std::size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(64))); }
+    void deallocate(T* p, std::size_t) { ::operator delete(p, std::align_val_t(64)); }
+    template <class U>
+    bool operator==(const CacheLineAllocator<U>&) const { return true; }
+};
+
+template <class T>
+using AlignedVector = std::vector<T, CacheLineAllocator<T>>;
 
 template <int N, int M>
 struct WideBvh {
