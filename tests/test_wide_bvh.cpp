@@ -12,10 +12,12 @@
 #include "tests/test_paths.h"
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cstdio>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <functional>
 #include <iomanip>
@@ -27,6 +29,8 @@
 #include "tests/oracle_harness.h"
 #include "accel/accel.h"
 #include "accel/brute/brute_force.h"
+#include "accel/bvh/build_from_scene.h"
+#include "accel/bvh/collapse.h"
 #include "accel/bvh/wide_bvh_accel.h"
 #include "render/camera_rays.h"
 #include "scene/load.h"
@@ -603,3 +607,31 @@ TEST_F(WideBvh, BigMixedLeafUsesRunTable) {
 
 }  // namespace
 }  // namespace raypack::wide_bvh_test
+
+TEST(WideBvhCollapse, SameTreeForAnyThreadCount) {
+    // The collapse writes the root's subtrees in parallel, each at offsets
+    // counted beforehand (accel/bvh/collapse.cpp): the arrays must come out
+    // byte for byte those of one thread. gen:mount:7 (32k triangles, four
+    // spheres) is past the parallel threshold (1024 wide nodes).
+    const raypack::Scene scene = raypack::load_scene("gen:mount:7");
+    const raypack::Bvh2 binary = raypack::build_scene_bvh2(scene, raypack::AccelConfig{});
+    auto collapse_with = [&](int threads) {
+        tbb::task_arena arena(threads);
+        raypack::WideBvh<4, 4> bvh;
+        arena.execute([&] { bvh = raypack::collapse_bvh<4, 4>(binary, scene, raypack::CollapseConfig{}); });
+        return bvh;
+    };
+    const raypack::WideBvh<4, 4> one = collapse_with(1), two = collapse_with(2);
+    ASSERT_GE(one.nodes.size(), 1024u);  // the parallel path runs
+    auto same_bytes = [](const auto& a, const auto& b) {
+        return a.size() == b.size() &&
+               std::memcmp(a.data(), b.data(), a.size() * sizeof(a[0])) == 0;
+    };
+    EXPECT_TRUE(same_bytes(one.nodes, two.nodes));
+    EXPECT_TRUE(same_bytes(one.triangles, two.triangles));
+    EXPECT_TRUE(same_bytes(one.spheres, two.spheres));
+    EXPECT_EQ(one.mixed.size(), two.mixed.size());
+    EXPECT_EQ(one.depth, two.depth);
+    EXPECT_EQ(one.leaves, two.leaves);
+    EXPECT_FALSE(one.spheres.empty());
+}

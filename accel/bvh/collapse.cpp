@@ -2,8 +2,12 @@
 
 #include <algorithm>
 #include <array>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 namespace raypack {
 namespace {
@@ -43,8 +47,7 @@ public:
             plan_optimal();
         }
         out_.triangle_layout = config_.triangle_layout;
-        reserve_output();
-        emit_node(0, 1);
+        emit_tree();
     }
 
 private:
@@ -58,7 +61,6 @@ private:
     // child (0: no better than i - 1 slots).
     std::vector<float> cost_;
     std::vector<std::uint8_t> split_;
-    std::array<std::vector<std::uint32_t>, 3> by_kind_;  ///< emit_leaf's scratch
 
     std::uint32_t left(std::uint32_t n) const { return n + 1; }
     std::uint32_t right(std::uint32_t n) const { return bvh_.nodes[n].first; }
@@ -158,26 +160,6 @@ private:
         }
     }
 
-    /// Room for every node and block at once. Grown by doubling, the arrays
-    /// were copied and their fresh pages faulted in again at each step: at 8
-    /// million triangles page faults were a third of the build (perf). The
-    /// bounds are loose (a leaf of the wide tree holds at most one part-full
-    /// block per kind, and there are no more of them than binary leaves), but
-    /// pages never written are never faulted in.
-    void reserve_output() {
-        std::size_t binary_leaves = 0;
-        for (const Bvh2Node& node : bvh_.nodes) binary_leaves += node.is_leaf();
-        const std::array<std::uint32_t, 3>& total = info_[0].count;
-        auto blocks = [&](LeafKind k) {
-            const std::uint32_t c = total[std::size_t(k)];
-            return std::size_t(c / M) + std::min<std::size_t>(c, binary_leaves);
-        };
-        out_.nodes.reserve(bvh_.nodes.size() / (N - 1) + 1);
-        out_.triangles.reserve(blocks(LeafKind::Triangle));
-        out_.spheres.reserve(blocks(LeafKind::Sphere));
-        out_.cones.reserve(blocks(LeafKind::Cone));
-    }
-
     /// Subtree m spread over at most i slots, as the optimal plan says.
     void gather(std::uint32_t m, int i, std::array<Slot, N>& slots, int& n) const {
         while (i > 1 && split_[m * N + i - 1] == 0) --i;
@@ -222,31 +204,131 @@ private:
         return n;
     }
 
-    std::uint32_t emit_node(std::uint32_t v, int depth) {
-        out_.depth = std::max(out_.depth, depth);
+    /// Where the next node, blocks and mixed run of a subtree go, and what
+    /// its emission saw (deepest level, leaves).
+    struct Cursor {
+        std::uint32_t node = 0, mixed = 0;
+        std::array<std::uint32_t, 3> blocks{};  ///< by LeafKind
+        int depth = 0;
+        std::size_t leaves = 0;
+        std::array<std::vector<std::uint32_t>, 3> by_kind;  ///< emit_leaf's scratch
+    };
+
+    /// What the subtree of the wide node made from binary node v writes:
+    /// nodes, blocks per kind and mixed runs (Cursor's counts).
+    void count(std::uint32_t v, Cursor& c) const {
         std::array<Slot, N> slots;
         const int n = plan_slots(v, slots);
-        const auto index = std::uint32_t(out_.nodes.size());
-        WideNode<N>& fresh = out_.nodes.emplace_back();
-        for (int i = 0; i < N; ++i) {
-            fresh.set_box(i, Box3f{});  // lo = +inf, hi = -inf
-            fresh.child[i] = wide_child::kEmpty;
-        }
+        ++c.node;
         for (int i = 0; i < n; ++i) {
-            const Slot c = slots[i];
-            const std::uint32_t code = c.leaf ? emit_leaf(c.node) : emit_node(c.node, depth + 1);
-            WideNode<N>& node = out_.nodes[index];  // emit_node may have grown the vector
-            node.set_box(i, bvh_.nodes[c.node].box);
-            node.child[i] = code;
+            if (slots[i].leaf) {
+                count_leaf(slots[i].node, c);
+            } else {
+                count(slots[i].node, c);
+            }
+        }
+    }
+
+    /// What emit_leaf writes for binary subtree v: its blocks, and a mixed
+    /// run when it holds several kinds or more blocks than a slot names.
+    void count_leaf(std::uint32_t v, Cursor& c) const {
+        int kinds = 0;
+        std::uint32_t blocks = 0;
+        for (int k = 0; k < 3; ++k) {
+            const std::uint32_t b = (info_[v].count[k] + M - 1) / M;
+            c.blocks[k] += b;
+            blocks += b;
+            kinds += b != 0;
+        }
+        c.mixed += kinds != 1 || blocks > wide_child::kMaxBlocks;
+    }
+
+    /// The wide tree, written in place: the sizes are counted first, so the
+    /// arrays are allocated once (grown by doubling they were copied and
+    /// faulted in page by page: a third of an 8-million-triangle build), and
+    /// with several threads the root's subtrees are written at once, each
+    /// from its own offsets. The output is the same for any thread count.
+    void emit_tree() {
+        std::array<Slot, N> slots;
+        const int n = plan_slots(0, slots);
+        // Each root slot's share, in the order a depth-first emission writes.
+        std::array<Cursor, N> part;
+        Cursor total;
+        total.node = 1;  // the root
+        for (int i = 0; i < n; ++i) {
+            Cursor& c = part[i];
+            c.node = total.node;
+            c.blocks = total.blocks;
+            c.mixed = total.mixed;
+            Cursor size;
+            if (slots[i].leaf) {
+                count_leaf(slots[i].node, size);
+            } else {
+                count(slots[i].node, size);
+            }
+            total.node += size.node;
+            total.mixed += size.mixed;
+            for (int k = 0; k < 3; ++k) total.blocks[k] += size.blocks[k];
+        }
+        if (std::uint64_t(total.blocks[0]) + total.blocks[1] + total.blocks[2] > wide_child::kIndexMask ||
+            total.mixed > wide_child::kIndexMask)
+            throw std::length_error("wide BVH: more leaf blocks than a child slot can address");
+        out_.nodes.resize(total.node);
+        out_.triangles.resize(total.blocks[std::size_t(LeafKind::Triangle)]);
+        out_.spheres.resize(total.blocks[std::size_t(LeafKind::Sphere)]);
+        out_.cones.resize(total.blocks[std::size_t(LeafKind::Cone)]);
+        out_.mixed.resize(total.mixed);
+
+        WideNode<N>& root = out_.nodes[0];
+        clear_node(root);
+        auto emit_slot = [&](int i) {
+            Cursor& c = part[i];
+            root.set_box(i, bvh_.nodes[slots[i].node].box);
+            root.child[i] = slots[i].leaf ? emit_leaf(slots[i].node, c) : emit_node(slots[i].node, 2, c);
+        };
+        if (total.node >= kParallelEmitNodes && tbb::this_task_arena::max_concurrency() > 1) {
+            tbb::parallel_for(0, n, emit_slot);
+        } else {
+            for (int i = 0; i < n; ++i) emit_slot(i);
+        }
+        out_.depth = 1;
+        for (int i = 0; i < n; ++i) {
+            out_.depth = std::max(out_.depth, part[i].depth);
+            out_.leaves += part[i].leaves;
+        }
+    }
+
+    /// A wide tree this large (in nodes) is written by several threads.
+    static constexpr std::uint32_t kParallelEmitNodes = 1024;
+
+    static void clear_node(WideNode<N>& node) {
+        std::memset(static_cast<void*>(&node), 0, sizeof(node));  // the padding too: the same bytes every build
+        for (int i = 0; i < N; ++i) {
+            node.set_box(i, Box3f{});  // lo = +inf, hi = -inf
+            node.child[i] = wide_child::kEmpty;
+        }
+    }
+
+    std::uint32_t emit_node(std::uint32_t v, int depth, Cursor& c) {
+        c.depth = std::max(c.depth, depth);
+        std::array<Slot, N> slots;
+        const int n = plan_slots(v, slots);
+        const std::uint32_t index = c.node++;
+        WideNode<N>& node = out_.nodes[index];
+        clear_node(node);
+        for (int i = 0; i < n; ++i) {
+            const Slot s = slots[i];
+            node.set_box(i, bvh_.nodes[s.node].box);
+            node.child[i] = s.leaf ? emit_leaf(s.node, c) : emit_node(s.node, depth + 1, c);
         }
         return index;
     }
 
     /// Packs the subtree's primitives, grouped by kind, into blocks.
-    std::uint32_t emit_leaf(std::uint32_t v) {
-        ++out_.leaves;
+    std::uint32_t emit_leaf(std::uint32_t v, Cursor& c) {
+        ++c.leaves;
         const SubtreeInfo& s = info_[v];
-        auto& by_kind = by_kind_;  // reused: no allocation per leaf
+        auto& by_kind = c.by_kind;  // reused: no allocation per leaf
         for (auto& list : by_kind) list.clear();
         for (std::uint32_t k = s.begin; k < s.end; ++k) {
             const std::uint32_t p = bvh_.prim_index[k];
@@ -259,32 +341,25 @@ private:
             if (prims.empty()) continue;
             ++kinds;
             last_kind = k;
-            runs.first[k] = std::uint32_t(block_count(LeafKind(k)));
+            runs.first[k] = c.blocks[k];
             for (std::size_t j = 0; j < prims.size(); j += M) {
                 const std::span<const std::uint32_t> chunk(prims.data() + j, std::min<std::size_t>(M, prims.size() - j));
+                const std::uint32_t b = c.blocks[k]++;
                 switch (LeafKind(k)) {
                     case LeafKind::Triangle:
-                        pack_triangles<M>(out_.triangles.emplace_back(), chunk, scene_, config_.triangle_layout);
+                        pack_triangles<M>(out_.triangles[b], chunk, scene_, config_.triangle_layout);
                         break;
-                    case LeafKind::Sphere: pack_spheres<M>(out_.spheres.emplace_back(), chunk, scene_); break;
-                    default: pack_cones<M>(out_.cones.emplace_back(), chunk, scene_); break;
+                    case LeafKind::Sphere: pack_spheres<M>(out_.spheres[b], chunk, scene_); break;
+                    default: pack_cones<M>(out_.cones[b], chunk, scene_); break;
                 }
                 ++runs.count[k];
             }
         }
-        if (kinds == 1 && runs.count[last_kind] <= wide_child::kMaxBlocks &&
-            runs.first[last_kind] <= wide_child::kIndexMask)
+        if (kinds == 1 && runs.count[last_kind] <= wide_child::kMaxBlocks)
             return wide_child::make_leaf(LeafKind(last_kind), runs.first[last_kind], runs.count[last_kind]);
-        if (out_.mixed.size() > wide_child::kIndexMask)
-            throw std::length_error("wide BVH: more leaf runs than a child slot can address");
-        out_.mixed.push_back(runs);
-        return wide_child::make_leaf(LeafKind::Mixed, std::uint32_t(out_.mixed.size() - 1), 1);
-    }
-
-    std::size_t block_count(LeafKind k) const {
-        return k == LeafKind::Triangle ? out_.triangles.size()
-               : k == LeafKind::Sphere ? out_.spheres.size()
-                                       : out_.cones.size();
+        const std::uint32_t m = c.mixed++;
+        out_.mixed[m] = runs;
+        return wide_child::make_leaf(LeafKind::Mixed, m, 1);
     }
 };
 

@@ -7,6 +7,7 @@
 // are runs of SoA blocks of M primitives of one kind (accel/bvh/leaf_blocks.h).
 #include <cstdint>
 #include <new>
+#include <utility>
 #include <vector>
 
 
@@ -73,6 +74,16 @@ struct CacheLineAllocator {
     CacheLineAllocator(const CacheLineAllocator<U>&) {}
     T* allocate(std::size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(64))); }
     void deallocate(T* p, std::size_t) { ::operator delete(p, std::align_val_t(64)); }
+    /// Default-initialises: resize() leaves trivial elements to their writer
+    /// (the collapse writes every field), so no page is touched twice.
+    template <class U>
+    void construct(U* p) {
+        ::new (static_cast<void*>(p)) U;
+    }
+    template <class U, class... Args>
+    void construct(U* p, Args&&... args) {
+        ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+    }
     template <class U>
     bool operator==(const CacheLineAllocator<U>&) const { return true; }
 };
