@@ -93,7 +93,8 @@ void reserve_heap_in_large_pages() {
 // huge pages. On this project's virtual machines a page fault costs several
 // microseconds: building a BVH4 over 8.4 million triangles (gen:mount:11)
 // spent more time faulting its fresh arrays in than building (docs/
-// structures.md). The deallocation functions stay the library's (free).
+// embree.md, "At a million triangles and more"). The deallocation functions
+// stay the library's (free).
 void* operator new(std::size_t bytes) { return raypack::app::allocate(bytes, 0); }
 void* operator new[](std::size_t bytes) { return raypack::app::allocate(bytes, 0); }
 void* operator new(std::size_t bytes, std::align_val_t a) { return raypack::app::allocate(bytes, std::size_t(a)); }
