@@ -12,7 +12,7 @@ scene and ray kind; the table gives medians over the rounds (docs/embree.md).
                 raypack picks for the kind of rays)
 
 usage: scripts/embree_check.py [--rounds N] [--res N] [--repeat R] [--build DIR]
-                               [--scenes a,b] [--kinds camera,shadow,diffuse]
+                               [--scenes a,b] [--kinds camera,shadow,diffuse] [--threads T]
 
 --scenes takes the names below or any scene raypack loads (a file or
 gen:NAME:SIZE), e.g. --scenes gen:tetra:10 for a million triangles.
@@ -53,17 +53,17 @@ def direct_best(build, scene, rays, repeat):
     return best
 
 
-def backend_best(build, scene, rays, repeat, out):
+def backend_best(build, scene, rays, repeat, out, threads):
     run([os.path.join(build, "raypack"), "bench", scene, "--rays-file", rays, "--accel", "embree,embree-robust",
-         "--packet", "1,4,8,16", "--repeat", str(repeat), "--json", out])
+         "--packet", "1,4,8,16", "--threads", str(threads), "--repeat", str(repeat), "--json", out])
     with open(out) as f:
         rows = json.load(f)
     row = max(rows, key=lambda r: r["mrays_per_s_median"])
     return row["mrays_per_s_median"], f'{row["accel"]} /{row["packet"]}'
 
 
-def default_config(build, scene, rays, repeat):
-    row = json.loads(run([os.path.join(build, "raypack"), "trace", scene, "--rays", rays, "--threads", "1",
+def default_config(build, scene, rays, repeat, threads):
+    row = json.loads(run([os.path.join(build, "raypack"), "trace", scene, "--rays", rays, "--threads", str(threads),
                           "--repeat", str(repeat), "--json"]).strip().splitlines()[-1])
     return row["mrays_per_s_median"], f'{row["accel"]} /{row["packet"]}'
 
@@ -76,6 +76,8 @@ def main():
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
     ap.add_argument("--scenes", default="bunny,tetra,balls")
     ap.add_argument("--kinds", default="camera,shadow,diffuse")
+    ap.add_argument("--threads", type=int, default=1,
+                    help="threads for the backend and raypack; embree_direct runs one thread, so above 1 it is left out")
     args = ap.parse_args()
     scenes = args.scenes.split(",")
     kinds = args.kinds.split(",")
@@ -94,9 +96,11 @@ def main():
             for s in scenes:
                 for k in kinds:
                     cell = results.setdefault((s, k), {"direct": [], "backend": [], "default": []})
-                    d = direct_best(args.build, SCENES.get(s, s), files[s, k], args.repeat)
-                    b = backend_best(args.build, SCENES.get(s, s), files[s, k], args.repeat, os.path.join(tmp, "b.json"))
-                    f = default_config(args.build, SCENES.get(s, s), files[s, k], args.repeat)
+                    d = (direct_best(args.build, SCENES.get(s, s), files[s, k], args.repeat) if args.threads == 1
+                         else (0.0, "-"))
+                    b = backend_best(args.build, SCENES.get(s, s), files[s, k], args.repeat, os.path.join(tmp, "b.json"),
+                                     args.threads)
+                    f = default_config(args.build, SCENES.get(s, s), files[s, k], args.repeat, args.threads)
                     cell["direct"].append(d)
                     cell["backend"].append(b)
                     cell["default"].append(f)
@@ -110,14 +114,17 @@ def main():
         names = [v[1] for v in values]
         return max(set(names), key=names.count)
 
-    print(f"{args.res} x {args.res} rays, one thread, medians of {args.rounds} rounds (Mrays/s)\n")
+    threads = "one thread" if args.threads == 1 else f"{args.threads} threads (no direct row)"
+    print(f"{args.res} x {args.res} rays, {threads}, medians of {args.rounds} rounds (Mrays/s)\n")
     print("| scene | rays | Embree direct best | backend best | backend / direct | raypack default | default / Embree best |")
     print("|---|---|---|---|---|---|---|")
     for (s, k), c in results.items():
         d, b, f = med(c["direct"]), med(c["backend"]), med(c["default"])
         best = max(d, b)
-        print(f"| {s} | {k} | {d:.1f} ({most_common(c['direct'])}) | {b:.1f} ({most_common(c['backend'])}) | "
-              f"{b / d:.2f} | {f:.1f} ({most_common(c['default'])}) | {f / best:.2f}x |")
+        direct = f"{d:.1f} ({most_common(c['direct'])})" if d > 0 else "-"
+        ratio = f"{b / d:.2f}" if d > 0 else "-"
+        print(f"| {s} | {k} | {direct} | {b:.1f} ({most_common(c['backend'])}) | "
+              f"{ratio} | {f:.1f} ({most_common(c['default'])}) | {f / best:.2f}x |")
 
 
 if __name__ == "__main__":
