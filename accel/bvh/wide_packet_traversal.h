@@ -25,6 +25,11 @@
 // before another's may be culled in one order and not in the other. Among
 // hits at exactly the same t, a block keeps the last for the packet and the
 // first for the single ray. tests/test_wide_bvh_packet.cpp checks this.
+//
+// SIMD locals here are not `const`: gcc 12 does not split a const aggregate
+// into registers ("store to a read-only decl" in -fdump-tree-sra-details),
+// and the triangle test then stored its broadcast vertices to the stack on
+// every iteration (docs/embree.md).
 #include <bit>
 #include <cmath>
 #include <algorithm>
