@@ -41,9 +41,11 @@ void advise_huge_pages(void* p, std::size_t bytes) {
 
 void* allocate(std::size_t bytes, std::size_t alignment) {
     for (;;) {
+        // A request of 0 bytes still gets a unique pointer ([basic.stc.dynamic.allocation]).
+        const std::size_t size = bytes ? bytes : 1;
         void* p = alignment <= alignof(std::max_align_t)
-                      ? std::malloc(bytes ? bytes : 1)
-                      : std::aligned_alloc(alignment, (bytes + alignment - 1) / alignment * alignment);
+                      ? std::malloc(size)
+                      : std::aligned_alloc(alignment, (size + alignment - 1) / alignment * alignment);
         if (p) {
             advise_huge_pages(p, bytes);
             return p;

@@ -77,7 +77,7 @@ std::string generate_spd(std::string_view name, int size) {
         if (size < 1 || size > max_size(e))
             throw std::invalid_argument("generate_spd: size " + std::to_string(size) + " out of range 1.." +
                                         std::to_string(max_size(e)) + " for '" + std::string(name) + "'" +
-                                        (size > 1 && e.limit == 0 ? " (larger sizes exceed " +
+                                        (size > max_size(e) && e.limit == 0 ? " (larger sizes exceed " +
                                                                         std::to_string(kMaxSpdPrimitives) +
                                                                         " primitives)"
                                                                   : ""));
