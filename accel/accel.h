@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "accel/primitive_intersector.h"
+#include "accel/traversal_counts.h"
 #include "kernels/ray.h"
 #include "scene/scene.h"
 
@@ -28,14 +29,6 @@ struct AccelStats {
     std::size_t empty_leaves = 0;   ///< empty leaves, or empty cells for the grid
     std::size_t primitives = 0;     ///< primitives in the scene the structure was built over
     double bytes_per_prim() const { return primitives ? double(bytes) / double(primitives) : 0.0; }
-};
-
-/// Work of tracing rays one at a time: nodes (or grid cells) entered, inner
-/// and leaf, and ray-primitive tests run. The figures papers compare
-/// structures by, independent of the machine.
-struct TraversalCounts {
-    std::uint64_t nodes = 0;
-    std::uint64_t prims = 0;
 };
 
 struct AccelConfig {

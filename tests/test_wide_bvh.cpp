@@ -191,22 +191,22 @@ void check_structure(const raypack::WideBvh<N, M>& bvh, const Scene& scene, cons
         if (++problems <= 5) ADD_FAILURE() << what;
     };
     // Checks one run of blocks of a leaf with box `box`.
-    auto check_run = [&](LeafKind kind, std::uint32_t first, std::uint32_t count, const Box3f& box) {
+    auto check_run = [&](std::uint32_t kind, std::uint32_t first, std::uint32_t count, const Box3f& box) {
         for (std::uint32_t b = first; b < first + count; ++b) {
             std::uint32_t used = 0;
             for (int j = 0; j < M; ++j) {
-                const std::uint32_t p = kind == LeafKind::Triangle ? bvh.triangles.at(b).prim[j]
-                                        : kind == LeafKind::Sphere ? bvh.spheres.at(b).prim[j]
-                                                                   : bvh.cones.at(b).prim[j];
+                const std::uint32_t p = PrimKinds::dispatch(PrimKind(kind), [&]<class Kind>() {
+                    return bvh.template blocks<Kind>().at(b).prim[j];
+                });
                 if (p == kNoPrim) continue;
                 ++used;
                 if (p >= n) { fail("bad primitive number"); continue; }
                 ++seen[p];
                 if (int(scene.prims[p].kind) != int(kind)) fail("primitive in a block of another kind");
                 if (!contains(box, primitive_bounds(scene, p))) fail("leaf box does not contain primitive " + std::to_string(p));
-                if (kind == LeafKind::Triangle && bvh.triangle_layout == TriangleLayout::Edges) {
+                if (PrimKind(kind) == PrimKind::Triangle && bvh.triangle_layout == TriangleLayout::Edges) {
                     const std::uint32_t t = scene.prims[p].index;
-                    const TriangleBlock<M>& tb = bvh.triangles[b];
+                    const TriangleBlock<M>& tb = bvh.template blocks<TrianglePrims>()[b];
                     const Vec3f p0 = scene.triangles.p0[t], e1n = p0 - scene.triangles.p1[t],
                                 e2 = scene.triangles.p2[t] - p0;
                     const Vec3f ng = fused_cross(e1n, e2);
@@ -245,10 +245,10 @@ void check_structure(const raypack::WideBvh<N, M>& bvh, const Scene& scene, cons
                 continue;
             }
             ++leaves;
-            const LeafKind kind = wide_child::kind(c);
-            if (kind == LeafKind::Mixed) {
+            const std::uint32_t kind = wide_child::kind(c);
+            if (kind == wide_child::kMixed) {
                 const MixedLeaf& m = bvh.mixed.at(wide_child::first(c));
-                for (int k = 0; k < 3; ++k) check_run(LeafKind(k), m.first[k], m.count[k], box);
+                for (int k = 0; k < kPrimKinds; ++k) check_run(std::uint32_t(k), m.first[k], m.count[k], box);
             } else {
                 check_run(kind, wide_child::first(c), wide_child::blocks(c), box);
             }
@@ -577,8 +577,8 @@ TEST_F(WideBvh, BigMixedLeafUsesRunTable) {
     const raypack::WideBvh<8, 4> bvh = collapse_bvh<8, 4>(binary, scene, CollapseConfig{});
     ASSERT_EQ(bvh.nodes.size(), 1u);
     ASSERT_TRUE(wide_child::is_leaf(bvh.nodes[0].child[0]));
-    EXPECT_EQ(wide_child::kind(bvh.nodes[0].child[0]), LeafKind::Mixed);
-    EXPECT_EQ(bvh.triangles.size(), 12u);  // 45 in blocks of 4
+    EXPECT_EQ(wide_child::kind(bvh.nodes[0].child[0]), wide_child::kMixed);
+    EXPECT_EQ(bvh.blocks<TrianglePrims>().size(), 12u);  // 45 in blocks of 4
     AccelStats stats;
     stats.nodes = 1;
     stats.leaves = 1;
@@ -628,10 +628,12 @@ TEST(WideBvhCollapse, SameTreeForAnyThreadCount) {
                std::memcmp(a.data(), b.data(), a.size() * sizeof(a[0])) == 0;
     };
     EXPECT_TRUE(same_bytes(one.nodes, two.nodes));
-    EXPECT_TRUE(same_bytes(one.triangles, two.triangles));
-    EXPECT_TRUE(same_bytes(one.spheres, two.spheres));
+    raypack::PrimKinds::until([&]<class Kind>() {
+        EXPECT_TRUE(same_bytes(one.blocks<Kind>(), two.blocks<Kind>())) << int(Kind::kind);
+        return false;
+    });
     EXPECT_EQ(one.mixed.size(), two.mixed.size());
     EXPECT_EQ(one.depth, two.depth);
     EXPECT_EQ(one.leaves, two.leaves);
-    EXPECT_FALSE(one.spheres.empty());
+    EXPECT_FALSE(one.blocks<raypack::SpherePrims>().empty());
 }

@@ -11,19 +11,6 @@
 
 namespace raypack {
 
-/// What the timed traversal counts: nothing (the calls compile away).
-struct NoTraversalCounts {
-    void node() {}
-    void prim() {}
-};
-
-/// What count_traversal counts: nodes entered and primitives tested.
-struct CountTraversal {
-    TraversalCounts& counts;
-    void node() { ++counts.nodes; }
-    void prim() { ++counts.prims; }
-};
-
 /// One ray against one box by the slab test `--slabs` names: Robust (Ize
 /// 2013, never culls a box the exact ray meets) or Plain (one FMA per plane,
 /// lo * rdir - org * rdir: faster, may lose hits on adversarial rays).

@@ -15,12 +15,12 @@ namespace {
 /// What the collapse needs to know of each binary node, computed bottom up.
 struct SubtreeInfo {
     std::uint32_t begin = 0, end = 0;  ///< its primitives: prim_index[begin, end)
-    std::array<std::uint32_t, 3> count{};  ///< primitives per kind
+    std::array<std::uint32_t, kPrimKinds> count{};  ///< primitives per kind
     bool leaf = false;                  ///< becomes a leaf of the wide tree
 };
 
 template <int M>
-std::uint32_t blocks_for(const std::array<std::uint32_t, 3>& count) {
+std::uint32_t blocks_for(const std::array<std::uint32_t, kPrimKinds>& count) {
     std::uint32_t b = 0;
     for (std::uint32_t c : count) b += (c + M - 1) / M;
     return b;
@@ -81,7 +81,7 @@ private:
             const SubtreeInfo &l = info_[i + 1], &r = info_[node.first];
             s.begin = l.begin;
             s.end = r.end;
-            for (int k = 0; k < 3; ++k) s.count[k] = l.count[k] + r.count[k];
+            for (int k = 0; k < kPrimKinds; ++k) s.count[k] = l.count[k] + r.count[k];
         }
     }
 
@@ -208,10 +208,10 @@ private:
     /// its emission saw (deepest level, leaves).
     struct Cursor {
         std::uint32_t node = 0, mixed = 0;
-        std::array<std::uint32_t, 3> blocks{};  ///< by LeafKind
+        std::array<std::uint32_t, kPrimKinds> blocks{};  ///< by PrimKind
         int depth = 0;
         std::size_t leaves = 0;
-        std::array<std::vector<std::uint32_t>, 3> by_kind;  ///< emit_leaf's scratch
+        std::array<std::vector<std::uint32_t>, kPrimKinds> by_kind;  ///< emit_leaf's scratch
     };
 
     /// What the subtree of the wide node made from binary node v writes:
@@ -234,7 +234,7 @@ private:
     void count_leaf(std::uint32_t v, Cursor& c) const {
         int kinds = 0;
         std::uint32_t blocks = 0;
-        for (int k = 0; k < 3; ++k) {
+        for (int k = 0; k < kPrimKinds; ++k) {
             const std::uint32_t b = (info_[v].count[k] + M - 1) / M;
             c.blocks[k] += b;
             blocks += b;
@@ -268,15 +268,18 @@ private:
             }
             total.node += size.node;
             total.mixed += size.mixed;
-            for (int k = 0; k < 3; ++k) total.blocks[k] += size.blocks[k];
+            for (int k = 0; k < kPrimKinds; ++k) total.blocks[k] += size.blocks[k];
         }
-        if (std::uint64_t(total.blocks[0]) + total.blocks[1] + total.blocks[2] > wide_child::kIndexMask ||
+        std::uint64_t all_blocks = 0;
+        for (std::uint32_t b : total.blocks) all_blocks += b;
+        if (all_blocks > wide_child::kIndexMask ||
             total.mixed > wide_child::kIndexMask)
             throw std::length_error("wide BVH: more leaf blocks than a child slot can address");
         out_.nodes.resize(total.node);
-        out_.triangles.resize(total.blocks[std::size_t(LeafKind::Triangle)]);
-        out_.spheres.resize(total.blocks[std::size_t(LeafKind::Sphere)]);
-        out_.cones.resize(total.blocks[std::size_t(LeafKind::Cone)]);
+        PrimKinds::until([&]<class Kind>() {
+            out_.template blocks<Kind>().resize(total.blocks[std::size_t(Kind::kind)]);
+            return false;
+        });
         out_.mixed.resize(total.mixed);
 
         WideNode<N>& root = out_.nodes[0];
@@ -336,7 +339,7 @@ private:
         }
         MixedLeaf runs{};
         int kinds = 0, last_kind = 0;
-        for (int k = 0; k < 3; ++k) {
+        for (int k = 0; k < kPrimKinds; ++k) {
             const std::vector<std::uint32_t>& prims = by_kind[k];
             if (prims.empty()) continue;
             ++kinds;
@@ -345,43 +348,29 @@ private:
             for (std::size_t j = 0; j < prims.size(); j += M) {
                 const std::span<const std::uint32_t> chunk(prims.data() + j, std::min<std::size_t>(M, prims.size() - j));
                 const std::uint32_t b = c.blocks[k]++;
-                switch (LeafKind(k)) {
-                    case LeafKind::Triangle:
-                        pack_triangles<M>(out_.triangles[b], chunk, scene_, config_.triangle_layout);
-                        break;
-                    case LeafKind::Sphere: pack_spheres<M>(out_.spheres[b], chunk, scene_); break;
-                    default: pack_cones<M>(out_.cones[b], chunk, scene_); break;
-                }
+                PrimKinds::dispatch(PrimKind(k), [&]<class Kind>() {
+                    Kind::template pack<M>(out_.template blocks<Kind>()[b], chunk, scene_, BlockLayout{config_.triangle_layout});
+                });
                 ++runs.count[k];
             }
         }
         if (kinds == 1 && runs.count[last_kind] <= wide_child::kMaxBlocks)
-            return wide_child::make_leaf(LeafKind(last_kind), runs.first[last_kind], runs.count[last_kind]);
+            return wide_child::make_leaf(std::uint32_t(last_kind), runs.first[last_kind], runs.count[last_kind]);
         const std::uint32_t m = c.mixed++;
         out_.mixed[m] = runs;
-        return wide_child::make_leaf(LeafKind::Mixed, m, 1);
+        return wide_child::make_leaf(wide_child::kMixed, m, 1);
     }
 };
 
 /// Primitives in the blocks of one leaf.
 template <int N, int M>
 std::uint32_t leaf_primitives(const WideBvh<N, M>& bvh, std::uint32_t code) {
-    auto count_run = [&](LeafKind k, std::uint32_t first, std::uint32_t n) {
-        std::uint32_t c = 0;
-        for (std::uint32_t b = first; b < first + n; ++b)
-            for (int j = 0; j < M; ++j) {
-                const std::uint32_t p = k == LeafKind::Triangle ? bvh.triangles[b].prim[j]
-                                        : k == LeafKind::Sphere ? bvh.spheres[b].prim[j]
-                                                                : bvh.cones[b].prim[j];
-                c += p != kNoPrim;
-            }
-        return c;
-    };
-    const LeafKind k = wide_child::kind(code);
-    if (k != LeafKind::Mixed) return count_run(k, wide_child::first(code), wide_child::blocks(code));
-    const MixedLeaf& m = bvh.mixed[wide_child::first(code)];
     std::uint32_t c = 0;
-    for (int j = 0; j < 3; ++j) c += count_run(LeafKind(j), m.first[j], m.count[j]);
+    bvh.template for_each_run<false>(code, [&]<class Kind>(const auto* blocks, std::uint32_t n) {
+        for (std::uint32_t b = 0; b < n; ++b)
+            for (std::uint32_t p : blocks[b].prim) c += p != kNoPrim;
+        return false;
+    });
     return c;
 }
 

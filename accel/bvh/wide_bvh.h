@@ -4,21 +4,22 @@
 // "Shallow Bounding Volume Hierarchies for Fast SIMD Ray Tracing of Incoherent
 // Rays", EGSR 2008; Ernst & Greiner, "Multi Bounding Volume Hierarchies",
 // RT 2008; Wald, Benthin, Boulos, "Getting Rid of Packets", RT 2008). Leaves
-// are runs of SoA blocks of M primitives of one kind (accel/bvh/leaf_blocks.h).
+// are runs of SoA blocks of M primitives of one kind (accel/prims/prim_kinds.h).
 #include <cstdint>
 #include <new>
+#include <tuple>
 #include <utility>
 #include <vector>
 
 
-#include "accel/bvh/leaf_blocks.h"
+#include "accel/prims/prim_kinds.h"
 #include "kernels/aabb.h"
 
 namespace raypack {
 
 /// A child slot: an inner node index, or a leaf (top bit set) naming a run of
-/// leaf blocks. Leaf bits: 30..29 kind (WideLeafKind), 28..26 blocks - 1,
-/// 25..0 first block (for kind Mixed: the index into WideBvh::mixed).
+/// leaf blocks. Leaf bits: 30..29 kind (a PrimKind, or kMixed), 28..26
+/// blocks - 1, 25..0 first block (for kMixed: the index into WideBvh::mixed).
 namespace wide_child {
 inline constexpr std::uint32_t kLeafBit = 0x80000000u;
 inline constexpr std::uint32_t kEmpty = 0xFFFFFFFFu;  ///< unused slot (its box is empty)
@@ -27,10 +28,13 @@ inline constexpr std::uint32_t kIndexMask = (1u << kCountShift) - 1u;
 inline constexpr std::uint32_t kMaxBlocks = 8;
 
 RAYPACK_INLINE bool is_leaf(std::uint32_t c) { return (c & kLeafBit) != 0; }
-RAYPACK_INLINE LeafKind kind(std::uint32_t c) { return LeafKind((c >> kKindShift) & 3u); }
+/// The kind of a leaf holding several kinds, or more blocks than a slot names.
+inline constexpr std::uint32_t kMixed = kPrimKinds;
+static_assert(kMixed <= 3, "the kind field has two bits");
+RAYPACK_INLINE std::uint32_t kind(std::uint32_t c) { return (c >> kKindShift) & 3u; }
 RAYPACK_INLINE std::uint32_t blocks(std::uint32_t c) { return ((c >> kCountShift) & 7u) + 1u; }
 RAYPACK_INLINE std::uint32_t first(std::uint32_t c) { return c & kIndexMask; }
-inline std::uint32_t make_leaf(LeafKind k, std::uint32_t first_block, std::uint32_t block_count) {
+inline std::uint32_t make_leaf(std::uint32_t k, std::uint32_t first_block, std::uint32_t block_count) {
     return kLeafBit | (std::uint32_t(k) << kKindShift) | ((block_count - 1u) << kCountShift) | first_block;
 }
 }  // namespace wide_child
@@ -57,10 +61,10 @@ struct alignas(64) WideNode {
 static_assert(sizeof(WideNode<4>) == 128 && sizeof(WideNode<8>) == 256);
 
 /// A leaf holding several kinds, or more blocks than a child slot can name:
-/// a run of blocks per kind (indexed by LeafKind; count 0 if none).
+/// a run of blocks per kind (indexed by PrimKind; count 0 if none).
 struct MixedLeaf {
-    std::uint32_t first[3];
-    std::uint32_t count[3];
+    std::uint32_t first[kPrimKinds];
+    std::uint32_t count[kPrimKinds];
 };  // total: 24 bytes
 
 /// Cache-line aligned storage through the aligned global `operator new`
@@ -94,18 +98,49 @@ using AlignedVector = std::vector<T, CacheLineAllocator<T>>;
 template <int N, int M>
 struct WideBvh {
     AlignedVector<WideNode<N>> nodes;  ///< root at 0; empty for an empty scene
-    AlignedVector<TriangleBlock<M>> triangles;
-    AlignedVector<SphereBlock<M>> spheres;
-    AlignedVector<ConeBlock<M>> cones;
+    PrimKinds::BlockStore<AlignedVector, M> block_store;  ///< one array per kind: blocks<Kind>()
     std::vector<MixedLeaf> mixed;
     TriangleLayout triangle_layout = TriangleLayout::Edges;
     int depth = 0;
     std::size_t leaves = 0;
 
+    template <class Kind>
+    AlignedVector<typename Kind::template Block<M>>& blocks() {
+        return std::get<AlignedVector<typename Kind::template Block<M>>>(block_store);
+    }
+    template <class Kind>
+    const AlignedVector<typename Kind::template Block<M>>& blocks() const {
+        return std::get<AlignedVector<typename Kind::template Block<M>>>(block_store);
+    }
+
+    /// fn.template operator()<Kind>(blocks, count) for each run of blocks of
+    /// leaf `code`, in PrimKinds order; fn returns whether it hit something,
+    /// and with StopAtHit (any hit) the first hit ends the leaf. Whether any
+    /// run hit. The one place a traversal learns a leaf's kinds.
+    template <bool StopAtHit, class Fn>
+    RAYPACK_INLINE bool for_each_run(std::uint32_t code, Fn&& fn) const {
+        const std::uint32_t first = wide_child::first(code), kind = wide_child::kind(code);
+        if (kind != wide_child::kMixed) {
+            const std::uint32_t count = wide_child::blocks(code);
+            return PrimKinds::dispatch(PrimKind(kind), [&]<class Kind>() RAYPACK_INLINE_LAMBDA {
+                return fn.template operator()<Kind>(blocks<Kind>().data() + first, count);
+            });
+        }
+        const MixedLeaf& m = mixed[first];
+        bool found = false;
+        PrimKinds::until([&]<class Kind>() RAYPACK_INLINE_LAMBDA {
+            constexpr int k = int(Kind::kind);
+            const bool hit = fn.template operator()<Kind>(blocks<Kind>().data() + m.first[k], m.count[k]);
+            found |= hit;
+            return StopAtHit && hit;
+        });
+        return found;
+    }
+
     std::size_t bytes() const {
-        return nodes.size() * sizeof(WideNode<N>) + triangles.size() * sizeof(TriangleBlock<M>) +
-               spheres.size() * sizeof(SphereBlock<M>) + cones.size() * sizeof(ConeBlock<M>) +
-               mixed.size() * sizeof(MixedLeaf);
+        std::size_t b = nodes.size() * sizeof(WideNode<N>) + mixed.size() * sizeof(MixedLeaf);
+        std::apply([&](const auto&... v) { ((b += v.size() * sizeof(v[0])), ...); }, block_store);
+        return b;
     }
 };
 

@@ -131,55 +131,6 @@ RAYPACK_INLINE vmask<K> child_hits(const WideNode<N>& node, int i, const PacketN
     return active & (entry <= exit);
 }
 
-/// Primitive j of a block against the active lanes: the lanes that hit it
-/// before their tfar, with t, u, v.
-template <TriangleMethod TM, class F, int M>
-RAYPACK_INLINE mask_of<F> intersect_one(const TriangleBlock<M>& b, int j, SphereMethod, const LeafRay<F>& r,
-                                        const mask_of<F>& active, const F& tfar, F& t, F& u, F& v) {
-    Vec3<F> p0{F(b.p0[0][j]), F(b.p0[1][j]), F(b.p0[2][j])};
-    Vec3<F> a{F(b.a[0][j]), F(b.a[1][j]), F(b.a[2][j])};
-    Vec3<F> c{F(b.b[0][j]), F(b.b[1][j]), F(b.b[2][j])};
-    if constexpr (TM == TriangleMethod::Moeller) {
-        Vec3<F> ng{F(b.ng[0][j]), F(b.ng[1][j]), F(b.ng[2][j])};
-        return intersect_triangle_moeller_edges<F>(active, r.org, r.dir, r.tnear, tfar, p0, a, c, ng, t, u, v);
-    } else if constexpr (TM == TriangleMethod::Watertight) {
-        return intersect_triangle_watertight<F>(active, r.watertight, r.tnear, tfar, p0, a, c, t, u, v);
-    } else {
-        return intersect_triangle_plane<F>(active, r.org, r.dir, r.tnear, tfar, p0, a, c, t, u, v);
-    }
-}
-
-template <TriangleMethod TM, class F, int M>
-RAYPACK_INLINE mask_of<F> intersect_one(const SphereBlock<M>& b, int j, SphereMethod method, const LeafRay<F>& r,
-                                        const mask_of<F>& active, const F& tfar, F& t, F& u, F& v) {
-    const QuadricRay<F> q{r.org, r.dir, r.tnear, tfar, r.dd, r.inv_dd};
-    Vec3<F> c{F(b.center[0][j]), F(b.center[1][j]), F(b.center[2][j])};
-    F radius(b.radius[j]);
-    u = v = F(0.0f);
-    switch (method) {
-        case SphereMethod::Algebraic: return intersect_sphere<SphereMethod::Algebraic, F>(active, q, c, radius, t);
-        case SphereMethod::Geometric: return intersect_sphere<SphereMethod::Geometric, F>(active, q, c, radius, t);
-        case SphereMethod::Precise: break;
-    }
-    return intersect_sphere<SphereMethod::Precise, F>(active, q, c, radius, t);
-}
-
-template <TriangleMethod TM, class F, int M>
-RAYPACK_INLINE mask_of<F> intersect_one(const ConeBlock<M>& b, int j, SphereMethod, const LeafRay<F>& r,
-                                        const mask_of<F>& active, const F& tfar, F& t, F& u, F& v) {
-    const QuadricRay<F> q{r.org, r.dir, r.tnear, tfar, r.dd, r.inv_dd};
-    ConeLanes<F> c;
-    c.base = {F(b.base[0][j]), F(b.base[1][j]), F(b.base[2][j])};
-    c.w = {F(b.w[0][j]), F(b.w[1][j]), F(b.w[2][j])};
-    c.mid = {F(b.mid[0][j]), F(b.mid[1][j]), F(b.mid[2][j])};
-    c.h = F(b.h[j]);
-    c.inv_h = F(b.inv_h[j]);
-    c.k = F(b.k[j]);
-    c.rb = F(b.rb[j]);
-    v = F(0.0f);
-    return intersect_cone<F>(active, q, c, t, u);
-}
-
 /// The per-packet state the leaves update: the closest hits so far, each
 /// lane's tfar (its closest t; -inf once an any-hit lane is occluded), the
 /// lanes still traced and, for any hit, the occluded ones.
@@ -192,9 +143,9 @@ struct PacketState {
     vmask<K>& occluded;
 };
 
-/// A run of blocks of one kind against the active lanes, one primitive at a
-/// time (padding lanes, prim = kNoPrim, end a block).
-template <TriangleMethod TM, bool AnyHit, int K, class Block>
+/// A run of blocks of kind Kind against the active lanes, one primitive at
+/// a time (padding lanes, prim = kNoPrim, end a block).
+template <class Kind, TriangleMethod TM, bool AnyHit, int K, class Block>
 RAYPACK_INLINE void packet_run(const Block* b, std::uint32_t count, SphereMethod sm, const LeafRay<vfloat<K>>& r,
                                vmask<K> active, PacketState<K>& s) {
     using F = vfloat<K>;
@@ -203,7 +154,7 @@ RAYPACK_INLINE void packet_run(const Block* b, std::uint32_t count, SphereMethod
     for (; count != 0; --count, ++b) {
         for (int j = 0; j < M && b->prim[j] != kNoPrim; ++j) {
             F t(0.0f), u(0.0f), v(0.0f);  // the kernels set only their hit lanes
-            vmask<K> m = intersect_one<TM, F, M>(*b, j, sm, r, active, s.tfar, t, u, v);
+            vmask<K> m = Kind::template intersect_slot<TM, F, M>(*b, j, sm, r, active, s.tfar, t, u, v);
             if (none(m)) continue;
             if constexpr (AnyHit) {
                 s.occluded = s.occluded | m;
@@ -223,21 +174,15 @@ RAYPACK_INLINE void packet_run(const Block* b, std::uint32_t count, SphereMethod
     }
 }
 
+/// The blocks of one leaf against the active lanes (any hit: each run
+/// against the lanes not yet occluded).
 template <TriangleMethod TM, bool AnyHit, int N, int M, int K>
 RAYPACK_INLINE void packet_leaf(const WideBvh<N, M>& bvh, SphereMethod sm, std::uint32_t code,
                                 const LeafRay<vfloat<K>>& r, const vmask<K>& active, PacketState<K>& s) {
-    const std::uint32_t first = wide_child::first(code), count = wide_child::blocks(code);
-    switch (wide_child::kind(code)) {
-        case LeafKind::Triangle: return packet_run<TM, AnyHit>(bvh.triangles.data() + first, count, sm, r, active, s);
-        case LeafKind::Sphere: return packet_run<TM, AnyHit>(bvh.spheres.data() + first, count, sm, r, active, s);
-        case LeafKind::Cone: return packet_run<TM, AnyHit>(bvh.cones.data() + first, count, sm, r, active, s);
-        case LeafKind::Mixed: break;
-    }
-    const MixedLeaf& m = bvh.mixed[first];
-    constexpr int tri = int(LeafKind::Triangle), sph = int(LeafKind::Sphere), cone = int(LeafKind::Cone);
-    packet_run<TM, AnyHit>(bvh.triangles.data() + m.first[tri], m.count[tri], sm, r, active, s);
-    packet_run<TM, AnyHit>(bvh.spheres.data() + m.first[sph], m.count[sph], sm, r, active & s.valid, s);
-    packet_run<TM, AnyHit>(bvh.cones.data() + m.first[cone], m.count[cone], sm, r, active & s.valid, s);
+    bvh.template for_each_run<false>(code, [&]<class Kind>(const auto* blocks, std::uint32_t n) RAYPACK_INLINE_LAMBDA {
+        packet_run<Kind, TM, AnyHit>(blocks, n, sm, r, AnyHit ? active & s.valid : active, s);
+        return false;
+    });
 }
 
 /// packet_leaf for --precision double: each primitive of the leaf's blocks,
@@ -248,11 +193,11 @@ inline void packet_leaf_by_prim(const WideBvh<N, M>& bvh, const PacketPrimitiveI
     using F = vfloat<K>;
     F minus_inf(-std::numeric_limits<float>::infinity());
     RayPacket<K> r = ray;
-    auto run = [&](const auto* b, std::uint32_t count) {
+    bvh.template for_each_run<false>(code, [&]<class Kind>(const auto* b, std::uint32_t count) {
         constexpr int BM = int(sizeof(b->prim) / sizeof(b->prim[0]));
         for (; count != 0; --count, ++b) {
             for (int j = 0; j < BM && b->prim[j] != kNoPrim; ++j) {
-                if (none(active)) return;
+                if (none(active)) return false;
                 r.tfar = s.tfar;
                 vmask<K> m = isect.intersect(active, r, s.hit, b->prim[j]);
                 if constexpr (AnyHit) {
@@ -265,18 +210,8 @@ inline void packet_leaf_by_prim(const WideBvh<N, M>& bvh, const PacketPrimitiveI
                 }
             }
         }
-    };
-    const std::uint32_t first = wide_child::first(code), count = wide_child::blocks(code);
-    switch (wide_child::kind(code)) {
-        case LeafKind::Triangle: return run(bvh.triangles.data() + first, count);
-        case LeafKind::Sphere: return run(bvh.spheres.data() + first, count);
-        case LeafKind::Cone: return run(bvh.cones.data() + first, count);
-        case LeafKind::Mixed: break;
-    }
-    const MixedLeaf& m = bvh.mixed[first];
-    run(bvh.triangles.data() + m.first[int(LeafKind::Triangle)], m.count[int(LeafKind::Triangle)]);
-    run(bvh.spheres.data() + m.first[int(LeafKind::Sphere)], m.count[int(LeafKind::Sphere)]);
-    run(bvh.cones.data() + m.first[int(LeafKind::Cone)], m.count[int(LeafKind::Cone)]);
+        return false;
+    });
 }
 
 /// What the packet traversal needs beyond the tree: the kernel variants and,

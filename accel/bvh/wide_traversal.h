@@ -12,6 +12,7 @@
 #include "accel/bvh/bvh2.h"  // kBvhMaxDepth
 #include "accel/bvh/wide_bvh.h"
 #include "accel/bvh/wide_node_test.h"
+#include "accel/traversal_counts.h"
 
 namespace raypack {
 
@@ -40,77 +41,22 @@ RAYPACK_INLINE void record_nearest(std::uint32_t bits, const F& t, const F& u, c
     hit.prim = prim[best];
 }
 
-/// Tests a run of blocks of one kind; true if something was hit (any hit:
-/// stops at the first).
-template <TriangleMethod TM, bool AnyHit, int M>
-RAYPACK_INLINE bool intersect_run(const TriangleBlock<M>* b, std::uint32_t count, SphereMethod,
-                                  const LeafRay<vfloat<M>>& r, float& tfar, Hitf& hit) {
+/// Tests a run of blocks of kind Kind; true if something was hit (any hit:
+/// stops at the first). `count` sees each block tested.
+template <class Kind, TriangleMethod TM, bool AnyHit, int M, class Count>
+RAYPACK_INLINE bool intersect_run(const typename Kind::template Block<M>* b, std::uint32_t n, SphereMethod sm,
+                                  const LeafRay<vfloat<M>>& r, float& tfar, Hitf& hit, Count& count) {
     using F = vfloat<M>;
     bool found = false;
-    for (; count != 0; --count, ++b) {
+    for (; n != 0; --n, ++b) {
+        count.block(b->prim);
         F t(0.0f), u(0.0f), v(0.0f);  // set by the kernel on hit lanes only
-        const std::uint32_t bits = mask_bits(intersect_block<TM, F, M>(*b, r, F(tfar), t, u, v));
+        const std::uint32_t bits = mask_bits(Kind::template intersect_block<TM, F, M>(*b, sm, r, F(tfar), t, u, v));
         if (bits == 0) continue;
         if constexpr (AnyHit) return true;
         found = true;
         record_nearest(bits, t, u, v, b->prim, tfar, hit);
     }
-    return found;
-}
-
-template <TriangleMethod TM, bool AnyHit, int M>
-RAYPACK_INLINE bool intersect_run(const SphereBlock<M>* b, std::uint32_t count, SphereMethod method,
-                                  const LeafRay<vfloat<M>>& r, float& tfar, Hitf& hit) {
-    using F = vfloat<M>;
-    bool found = false;
-    for (; count != 0; --count, ++b) {
-        F t(0.0f);
-        const std::uint32_t bits = mask_bits(intersect_block<F, M>(*b, method, r, F(tfar), t));
-        if (bits == 0) continue;
-        if constexpr (AnyHit) return true;
-        found = true;
-        record_nearest(bits, t, F(0.0f), F(0.0f), b->prim, tfar, hit);
-    }
-    return found;
-}
-
-template <TriangleMethod TM, bool AnyHit, int M>
-RAYPACK_INLINE bool intersect_run(const ConeBlock<M>* b, std::uint32_t count, SphereMethod,
-                                  const LeafRay<vfloat<M>>& r, float& tfar, Hitf& hit) {
-    using F = vfloat<M>;
-    bool found = false;
-    for (; count != 0; --count, ++b) {
-        F t(0.0f), s(0.0f);
-        const std::uint32_t bits = mask_bits(intersect_block<F, M>(*b, r, F(tfar), t, s));
-        if (bits == 0) continue;
-        if constexpr (AnyHit) return true;
-        found = true;
-        record_nearest(bits, t, s, F(0.0f), b->prim, tfar, hit);
-    }
-    return found;
-}
-
-/// Tests the blocks of one leaf; true if something was hit.
-template <TriangleMethod TM, bool AnyHit, int N, int M>
-RAYPACK_INLINE bool intersect_leaf(const WideBvh<N, M>& bvh, SphereMethod sm, std::uint32_t code,
-                                   const LeafRay<vfloat<M>>& r, float& tfar, Hitf& hit) {
-    const std::uint32_t first = wide_child::first(code), count = wide_child::blocks(code);
-    switch (wide_child::kind(code)) {
-        case LeafKind::Triangle:
-            return intersect_run<TM, AnyHit>(bvh.triangles.data() + first, count, sm, r, tfar, hit);
-        case LeafKind::Sphere:
-            return intersect_run<TM, AnyHit>(bvh.spheres.data() + first, count, sm, r, tfar, hit);
-        case LeafKind::Cone:
-            return intersect_run<TM, AnyHit>(bvh.cones.data() + first, count, sm, r, tfar, hit);
-        case LeafKind::Mixed: break;
-    }
-    const MixedLeaf& m = bvh.mixed[first];
-    constexpr int tri = int(LeafKind::Triangle), sph = int(LeafKind::Sphere), cone = int(LeafKind::Cone);
-    bool found = intersect_run<TM, AnyHit>(bvh.triangles.data() + m.first[tri], m.count[tri], sm, r, tfar, hit);
-    if (AnyHit && found) return true;
-    found |= intersect_run<TM, AnyHit>(bvh.spheres.data() + m.first[sph], m.count[sph], sm, r, tfar, hit);
-    if (AnyHit && found) return true;
-    found |= intersect_run<TM, AnyHit>(bvh.cones.data() + m.first[cone], m.count[cone], sm, r, tfar, hit);
     return found;
 }
 
@@ -122,12 +68,13 @@ struct PrimLeafRay {
     Rayf ray;  ///< tfar is replaced by the current closest hit at each test
 };
 
-template <bool AnyHit, class Block>
-RAYPACK_INLINE bool intersect_run_by_prim(const Block* b, std::uint32_t count, const PrimLeafRay& p, float& tfar,
-                                          Hitf& hit) {
+template <bool AnyHit, class Block, class Count>
+RAYPACK_INLINE bool intersect_run_by_prim(const Block* b, std::uint32_t n, const PrimLeafRay& p, float& tfar,
+                                          Hitf& hit, Count& count) {
     constexpr int M = int(sizeof(b->prim) / sizeof(b->prim[0]));
     bool found = false;
-    for (; count != 0; --count, ++b) {
+    for (; n != 0; --n, ++b) {
+        count.block(b->prim);
         for (int j = 0; j < M && b->prim[j] != kNoPrim; ++j) {  // padding ends a block
             Rayf r = p.ray;
             r.tfar = tfar;
@@ -140,25 +87,18 @@ RAYPACK_INLINE bool intersect_run_by_prim(const Block* b, std::uint32_t count, c
     return found;
 }
 
-/// intersect_leaf for --precision double.
-template <bool AnyHit, int N, int M>
-inline bool intersect_leaf_by_prim(const WideBvh<N, M>& bvh, std::uint32_t code, const PrimLeafRay& p, float& tfar,
-                                   Hitf& hit) {
-    const std::uint32_t first = wide_child::first(code), count = wide_child::blocks(code);
-    switch (wide_child::kind(code)) {
-        case LeafKind::Triangle: return intersect_run_by_prim<AnyHit>(bvh.triangles.data() + first, count, p, tfar, hit);
-        case LeafKind::Sphere: return intersect_run_by_prim<AnyHit>(bvh.spheres.data() + first, count, p, tfar, hit);
-        case LeafKind::Cone: return intersect_run_by_prim<AnyHit>(bvh.cones.data() + first, count, p, tfar, hit);
-        case LeafKind::Mixed: break;
-    }
-    const MixedLeaf& m = bvh.mixed[first];
-    constexpr int tri = int(LeafKind::Triangle), sph = int(LeafKind::Sphere), cone = int(LeafKind::Cone);
-    bool found = intersect_run_by_prim<AnyHit>(bvh.triangles.data() + m.first[tri], m.count[tri], p, tfar, hit);
-    if (AnyHit && found) return true;
-    found |= intersect_run_by_prim<AnyHit>(bvh.spheres.data() + m.first[sph], m.count[sph], p, tfar, hit);
-    if (AnyHit && found) return true;
-    found |= intersect_run_by_prim<AnyHit>(bvh.cones.data() + m.first[cone], m.count[cone], p, tfar, hit);
-    return found;
+/// Tests the blocks of one leaf, through the block kernels or, ByPrim
+/// (--precision double), by id; true if something was hit.
+template <TriangleMethod TM, bool AnyHit, bool ByPrim, int N, int M, class Count>
+RAYPACK_INLINE bool intersect_leaf(const WideBvh<N, M>& bvh, SphereMethod sm, std::uint32_t code,
+                                   const LeafRay<vfloat<M>>& r, const PrimLeafRay* by_prim, float& tfar, Hitf& hit,
+                                   Count& count) {
+    count.node();
+    return bvh.template for_each_run<AnyHit>(code, [&]<class Kind>(const auto* blocks, std::uint32_t n)
+                                                        RAYPACK_INLINE_LAMBDA {
+        if constexpr (ByPrim) return intersect_run_by_prim<AnyHit>(blocks, n, *by_prim, tfar, hit, count);
+        else return intersect_run<Kind, TM, AnyHit, M>(blocks, n, sm, r, tfar, hit, count);
+    });
 }
 
 /// One ray through the subtree under child slot `root` (an inner node or a
@@ -167,10 +107,13 @@ inline bool intersect_leaf_by_prim(const WideBvh<N, M>& bvh, std::uint32_t code,
 /// single-ray fallback of the packet traversal (accel/bvh/wide_packet.h).
 /// True if it found a hit (any hit: returns at the first). ByPrim: leaves
 /// go through `by_prim` (--precision double), not the block kernels.
-template <int N, int M, TriangleMethod TM, NodeTest Test, bool AnyHit, bool ByPrim = false>
+/// `count` sees each node and leaf entered and each block tested
+/// (count_traversal); NoTraversalCounts compiles away.
+template <int N, int M, TriangleMethod TM, NodeTest Test, bool AnyHit, bool ByPrim = false,
+          class Count = NoTraversalCounts>
 RAYPACK_INLINE bool trace_wide_subtree(const WideBvh<N, M>& bvh, SphereMethod sphere_method, std::uint32_t root,
                                        const NodeRay<N>& nr, const LeafRay<vfloat<M>>& lr, float& tfar, Hitf& hit,
-                                       const PrimLeafRay* by_prim = nullptr) {
+                                       const PrimLeafRay* by_prim = nullptr, Count count = {}) {
     using F = vfloat<N>;
     // Every level but the leaves pushes at most N - 1 entries.
     constexpr int kStackSize = (N - 1) * kBvhMaxDepth + 1;
@@ -182,6 +125,7 @@ RAYPACK_INLINE bool trace_wide_subtree(const WideBvh<N, M>& bvh, SphereMethod sp
     bool found = false;
     for (;;) {
         while (!wide_child::is_leaf(cur)) {
+            count.node();
             const WideNode<N>& node = nodes[cur];
             F entry;
             std::uint32_t bits = node_hits<Test>(node, nr, tfar_v, entry);
@@ -229,10 +173,7 @@ RAYPACK_INLINE bool trace_wide_subtree(const WideBvh<N, M>& bvh, SphereMethod sp
                 cur = (--sp)->node;
             }
         }
-        bool leaf_hit;
-        if constexpr (ByPrim) leaf_hit = intersect_leaf_by_prim<AnyHit>(bvh, cur, *by_prim, tfar, hit);
-        else leaf_hit = intersect_leaf<TM, AnyHit>(bvh, sphere_method, cur, lr, tfar, hit);
-        if (leaf_hit) {
+        if (intersect_leaf<TM, AnyHit, ByPrim>(bvh, sphere_method, cur, lr, by_prim, tfar, hit, count)) {
             found = true;
             if constexpr (AnyHit) return true;
             tfar_v = F(node_tfar(tfar));
@@ -251,20 +192,21 @@ RAYPACK_INLINE bool trace_wide_subtree(const WideBvh<N, M>& bvh, SphereMethod sp
 /// says whether there is one) or any hit (returns true at the first) of one
 /// ray in [tnear, tfar], with the node test variants `slabs`, `rcp` (see
 /// make_node_ray); ByPrim (--precision double) tests leaves through `isect`.
-template <int N, int M, TriangleMethod TM, NodeTest Test, bool AnyHit, bool ByPrim = false>
+template <int N, int M, TriangleMethod TM, NodeTest Test, bool AnyHit, bool ByPrim = false,
+          class Count = NoTraversalCounts>
 bool trace_wide(const WideBvh<N, M>& bvh, SphereMethod sphere_method, const Rayf& ray, Hitf& hit,
                 SlabMethod slabs = SlabMethod::Robust, RcpMethod rcp = RcpMethod::Exact,
-                const PrimitiveIntersector<float>* isect = nullptr) {
+                const PrimitiveIntersector<float>* isect = nullptr, Count count = {}) {
     if (bvh.nodes.empty()) return false;
     float tfar = ray.tfar;
     const NodeRay<N> nr = make_node_ray<Test, N>(ray, slabs, rcp);
     if constexpr (ByPrim) {
         const PrimLeafRay p{isect, ray};
         return trace_wide_subtree<N, M, TM, Test, AnyHit, true>(bvh, sphere_method, 0, nr, LeafRay<vfloat<M>>{}, tfar,
-                                                                hit, &p);
+                                                                hit, &p, count);
     } else {
-        return trace_wide_subtree<N, M, TM, Test, AnyHit>(bvh, sphere_method, 0, nr, make_leaf_ray<vfloat<M>>(ray, TM),
-                                                          tfar, hit);
+        return trace_wide_subtree<N, M, TM, Test, AnyHit, false>(
+            bvh, sphere_method, 0, nr, make_leaf_ray<vfloat<M>>(ray, TM), tfar, hit, nullptr, count);
     }
 }
 
