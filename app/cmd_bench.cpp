@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "accel/bvh/bvh_builders.h"
+#include "app/scene_options.h"
 #include "app/accel_options.h"
 #include "app/bench_measure.h"
 #include "app/bench_report.h"
@@ -114,7 +115,7 @@ void print_help() {
         "                 in ULPs, self-intersections from scale 1e-4 to 1e6, image error against a\n"
         "                 double reference (docs/accuracy.md)\n",
         accel_kinds_list().c_str(), offset_policy_list().c_str(), offset_policy_name(kDefaultOffset),
-        bvh_builder_list().c_str(), kernel_options_help().c_str());
+        bvh_builder_list().c_str(), (kernel_options_help() + scene_option_help()).c_str());
 }
 
 BenchPlan plan_from(const ParsedArgs& p) {
@@ -216,7 +217,7 @@ int run_bench(const Args& args) {
                                      {"--rays-file", "", 1}, {"--threads", "", 1}, {"--repeat", "", 1},
                                      {"--res", "", 2}, {"--json", "", 1}, {"--csv", "", 1}, {"--quick", "", 0},
                                      {"--tradeoff", "", 0}, {"--builder", "", 1}, {"--embree-quality", "", 1},
-                                     offset_option_spec()};
+                                     offset_option_spec(), scene_option_spec()};
     for (OptionSpec& k : kernel_option_specs()) specs.push_back(std::move(k));
     const ParsedArgs p(args, specs, 1000);
     if (p.help()) {
@@ -241,7 +242,7 @@ int run_bench(const Args& args) {
                 plan.builder.c_str());
     print_bench_header(stdout);
     for (const std::string& scene_spec : plan.scenes) {
-        const Scene scene = load_scene(scene_spec);
+        const Scene scene = load_scene_from(p, scene_spec);
         const std::string scene_name = short_scene_name(scene_spec);
         // Ray sets and oracle answers once per scene, shared by every structure.
         std::vector<BenchRays> sets;

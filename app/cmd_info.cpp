@@ -1,6 +1,7 @@
 // raypack info SCENE
 #include <cstdio>
 
+#include "app/scene_options.h"
 #include "app/commands.h"
 #include "scene/load.h"
 
@@ -12,17 +13,23 @@ void print_vec(const char* label, const Vec3f& v) { std::printf("  %-10s %g %g %
 }  // namespace
 
 int run_info(const Args& args) {
-    const ParsedArgs p(args, {}, 1);
+    const ParsedArgs p(args, {scene_option_spec()}, 1);
     if (p.help() || p.positional().empty()) {
-        std::printf("usage: raypack info SCENE\n");
+        std::printf("usage: raypack info SCENE [--heightfield-as field|triangles]\n%s", scene_option_help().c_str());
         if (!p.help()) throw UsageError("missing SCENE");
         return 0;
     }
-    const Scene scene = load_scene(p.positional()[0]);
+    const Scene scene = load_scene_from(p, p.positional()[0]);
     std::printf("scene: %s\n", scene.source.c_str());
     std::printf("primitives: %zu\n", scene.primitive_count());
     std::printf("  spheres    %zu\n  triangles  %zu\n  cones      %zu\n", scene.spheres.size(), scene.triangles.size(),
                 scene.cones.size());
+    if (!scene.height_fields.empty()) {
+        std::size_t samples = 0, bytes = 0;
+        for (const HeightField& h : scene.height_fields) samples += h.z.size(), bytes += h.bytes();
+        std::printf("  height fields %zu (%zu samples, %.1f MiB with their min/max pyramids)\n",
+                    scene.height_fields.size(), samples, double(bytes) / (1 << 20));
+    }
     std::printf("materials: %zu\n", scene.materials.size());
     const Box3f b = scene_bounds(scene);
     std::printf("bounds:\n");
@@ -63,6 +70,7 @@ int run_info(const Args& args) {
     const std::pair<bool, const char*> names[] = {{f.spheres, "spheres"},
                                                   {f.triangles, "triangles"},
                                                   {f.cones, "cones"},
+                                                  {f.height_fields, "height-fields"},
                                                   {f.vertex_normals, "vertex-normals"},
                                                   {f.reflection, "reflection"},
                                                   {f.transmission, "transmission"},

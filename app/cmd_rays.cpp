@@ -2,6 +2,7 @@
 // Writes the ray sets the benchmarks and the Embree comparison trace.
 #include <cstdio>
 
+#include "app/scene_options.h"
 #include "app/commands.h"
 #include "app/variant_options.h"
 #include "render/camera_rays.h"
@@ -13,7 +14,7 @@ namespace raypack::app {
 
 int run_rays(const Args& args) {
     const ParsedArgs p(args, {{"--kind", "", 1}, {"--res", "", 2}, {"--output", "-o", 1}, {"--seed", "", 1},
-                              offset_option_spec()},
+                              offset_option_spec(), scene_option_spec()},
                        1);
     if (p.help() || p.positional().empty()) {
         std::printf(
@@ -24,14 +25,14 @@ int run_rays(const Args& args) {
             "           else a distant one, else an area light's centre (a sphere's facing point)\n"
             "  diffuse  a cosine-weighted bounce from each camera hit (kind 0); --seed S (default 1)\n"
             "%s",
-            offset_option_help().c_str());
+            (offset_option_help() + scene_option_help()).c_str());
         if (!p.help()) throw UsageError("missing SCENE");
         return 0;
     }
     if (!p.has("--output")) throw UsageError("missing -o FILE.rays");
     const std::string kind = p.text("--kind", "camera");
     const OffsetPolicy offset = offset_policy_from(p);
-    const Scene scene = load_scene(p.positional()[0]);
+    const Scene scene = load_scene_from(p, p.positional()[0]);
     const int w = int(p.integer("--res", scene.camera.width, 1, 16384, 0));
     const int h = int(p.integer("--res", scene.camera.height, 1, 16384, 1));
     std::vector<Rayf> rays;

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <unistd.h>
 
+#include "app/scene_options.h"
 #include "app/accel_options.h"
 #include "app/default_config.h"
 #include "app/commands.h"
@@ -99,7 +100,7 @@ int run_render(const Args& args) {
                              {"--quiet", "-q", 0}, {"--integrator", "", 1}, {"--spp", "", 1}, {"--sampler", "", 1},
                              {"--seed", "", 1}, {"--light-samples", "", 1}, {"--filter", "", 1},
                              {"--rr-depth", "", 1}, {"--exposure", "", 1}, {"--adaptive", "", 1},
-                             {"--adaptive-depth", "", 1}});
+                             {"--adaptive-depth", "", 1}, scene_option_spec()});
     const ParsedArgs p(args, spec, 1);
     if (p.help() || p.positional().empty()) {
         std::printf(
@@ -129,7 +130,7 @@ int run_render(const Args& args) {
             "  --json        print one JSON line (times, ray counts, Mrays/s) instead of the text report\n"
             "  --quiet, -q   print nothing on success\n"
             "  A progress line is shown on a terminal for renders that take more than a second.\n%s",
-            accel_options_help().c_str());
+            (accel_options_help() + scene_option_help()).c_str());
         if (!p.help()) throw UsageError("missing SCENE");
         return 0;
     }
@@ -179,7 +180,7 @@ int run_render(const Args& args) {
     if (p.has("--aov") && aov != "cost") throw UsageError("--aov: expected cost, got '" + aov + "'");
 
     auto t0 = std::chrono::steady_clock::now();
-    const Scene scene = load_scene(scene_spec);
+    const Scene scene = load_scene_from(p, scene_spec);
     const double load_ms = ms_since(t0);
     options.width = int(p.integer("--res", scene.camera.width, 1, 65536, 0));
     options.height = int(p.integer("--res", scene.camera.height, 1, 65536, 1));
@@ -256,8 +257,9 @@ int run_render(const Args& args) {
     }
     if (quiet) return 0;
     std::printf("raypack render: %s\n", scene.source.c_str());
-    std::printf("  scene      %zu primitives (%zu spheres, %zu triangles, %zu cones), %zu lights, loaded in %.1f ms\n",
+    std::printf("  scene      %zu primitives (%zu spheres, %zu triangles, %zu cones, %zu height fields), %zu lights, loaded in %.1f ms\n",
                 scene.primitive_count(), scene.spheres.size(), scene.triangles.size(), scene.cones.size(),
+                scene.height_fields.size(),
                 scene.lights.size(), load_ms);
     std::printf("  structure  %s (%s), built in %.1f ms: %zu nodes, %zu leaves (%zu empty), depth %d, "
                 "%.2f refs/prim, %.1f KiB, SAH cost %.2f\n",

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <vector>
 
+#include "app/scene_options.h"
 #include "app/accel_options.h"
 #include "app/commands.h"
 #include "app/default_config.h"
@@ -46,6 +47,7 @@ double trace_all(const Accel& accel, int packet, const RayFile& file, std::vecto
 
 int run_trace(const Args& args) {
     auto spec = accel_option_specs();
+    spec.push_back(scene_option_spec());
     spec.insert(spec.end(), {{"--rays", "", 1}, {"--output", "-o", 1}, {"--threads", "", 1}, {"--repeat", "", 1},
                              {"--json", "", 0}});
     const ParsedArgs p(args, spec, 1);
@@ -57,7 +59,7 @@ int run_trace(const Args& args) {
             "  --repeat R    timed passes after one untimed warm-up (default 5); the median is reported\n"
             "  --threads T   worker threads (default: all cores)\n"
             "  --json        print one JSON line instead of text\n%s",
-            accel_options_help().c_str());
+            (accel_options_help() + scene_option_help()).c_str());
         if (!p.help()) throw UsageError("missing SCENE");
         return 0;
     }
@@ -66,7 +68,7 @@ int run_trace(const Args& args) {
     const int repeat = int(p.integer("--repeat", 5, 1, 100000));
     const ThreadLimit limit(int(p.integer("--threads", 0, 1, 1024)));
 
-    const Scene scene = load_scene(p.positional()[0]);
+    const Scene scene = load_scene_from(p, p.positional()[0]);
     const RayFile file = read_rays(p.text("--rays"));
     const RayWorkload workload = classify_workload(file.rays, file.kind == RayKind::AnyHit);
     const bool fastest = uses_fastest_config(p);

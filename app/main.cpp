@@ -6,6 +6,8 @@
 
 #include "app/commands.h"
 #include "app/heap_pages.h"
+#include "render/image.h"
+#include "scene/load.h"
 
 namespace {
 
@@ -30,6 +32,15 @@ void print_usage(std::FILE* out) {
 
 int main(int argc, char** argv) {
     raypack::app::reserve_heap_in_large_pages();
+    // NFF's `hf FILE`: heights from an image's first channel, through OpenImageIO.
+    raypack::set_height_image_reader([](const std::string& path, std::uint32_t& w, std::uint32_t& h) {
+        const raypack::Image image = raypack::read_image(path);
+        w = std::uint32_t(image.width);
+        h = std::uint32_t(image.height);
+        std::vector<float> first(std::size_t(w) * h);
+        for (std::size_t p = 0; p < first.size(); ++p) first[p] = image.rgb[p * 3];
+        return first;
+    });
     if (argc < 2) {
         print_usage(stderr);
         return 2;

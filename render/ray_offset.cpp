@@ -79,6 +79,7 @@ Vec3f accurate_hit_point(const Scene& scene, const Rayf& ray, const Hitf& hit) {
             const float len = length(d);
             return len > 0 ? c + d * (scene.spheres.radius[i] / len) : c + d;
         }
+        case PrimKind::HeightField: return height_field_point(scene.height_fields[i], hit.u, hit.v);
         case PrimKind::Cone: break;
     }
     return ray.org + ray.dir * hit.t;

@@ -38,6 +38,10 @@ Surface surface_at(const Scene& scene, const Rayf& ray, const Hitf& hit) {
             s.shading_normal = t.has_normals[i] ? smooth_normal(t, i, hit, s.geometric_normal) : s.geometric_normal;
             break;
         }
+        case PrimKind::HeightField:
+            s.geometric_normal = normalize(height_field_normal(scene.height_fields[i], hit.u, hit.v));
+            s.shading_normal = s.geometric_normal;
+            break;
         case PrimKind::Cone:
             s.geometric_normal = normalize(cone_normal(s.point, scene.cones.base[i], scene.cones.base_radius[i],
                                                        scene.cones.apex[i], scene.cones.apex_radius[i]));

@@ -21,6 +21,16 @@ SceneError::SceneError(const std::string& file, int line, const std::string& pro
       problem_(problem) {}
 
 namespace {
+HeightImageReader& height_image_reader_slot() {
+    static HeightImageReader reader;
+    return reader;
+}
+}  // namespace
+
+void set_height_image_reader(HeightImageReader reader) { height_image_reader_slot() = std::move(reader); }
+const HeightImageReader& height_image_reader() { return height_image_reader_slot(); }
+
+namespace {
 
 /// gen:NAME:SIZE -> the SPD generator's NFF text, parsed in memory.
 Scene load_generated(const std::string& spec) {

@@ -1,8 +1,11 @@
 #pragma once
 // Scene loading: NFF, OBJ and generated SPD scenes, by one entry point.
+#include <cstdint>
+#include <functional>
 #include <iosfwd>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "scene/scene.h"
 
@@ -22,6 +25,14 @@ private:
     int line_;
     std::string problem_;
 };
+
+/// Reads an image's first channel as floats, row-major from the top row, for
+/// NFF's `hf FILE`: the scene layer reads no images itself, so the program
+/// installs one (raypack's reads through OpenImageIO, render/image.h).
+using HeightImageReader =
+    std::function<std::vector<float>(const std::string& path, std::uint32_t& width, std::uint32_t& height)>;
+void set_height_image_reader(HeightImageReader reader);
+const HeightImageReader& height_image_reader();
 
 /// SPEC is a path ending in .nff or .obj, or gen:NAME:SIZE (see scene/spd/spd.h).
 Scene load_scene(const std::string& spec);

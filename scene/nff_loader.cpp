@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "scene/load.h"
+#include "scene/memory_budget.h"
 #include "scene/nff_text.h"
 #include "scene/number_token.h"
 #include "scene/read_file.h"
@@ -23,6 +24,9 @@ namespace {
 /// Largest polygon we accept; checked before anything is allocated.
 constexpr long long kMaxPolygonVertices = 1'000'000;
 constexpr long long kMaxResolution = 65536;
+/// Largest height field side, in samples (2^28 samples are 1 GiB of floats).
+constexpr long long kMaxHeightFieldSide = 65536;
+constexpr long long kMaxHeightFieldSamples = 1ll << 28;
 
 /// Tokens with the line each starts on; '#' comments run to the end of a line.
 class Tokenizer {
@@ -110,6 +114,7 @@ public:
             else if (kw == "obj") obj_mesh();
             else if (kw == "lens") lens();
             else if (kw == "gloss") gloss();
+            else if (kw == "hf") height_field();
             else if (float x; parse_float_token(kw, x) != NumberToken::NotNumber)
                 fail(entity_line_, "unexpected number " + quote_token(kw) +
                                        " where an entity keyword was expected (too many values before it?)");
@@ -295,6 +300,75 @@ private:
         } catch (const SceneError& e) {
             fail(entity_line_, "obj " + quote_token(file) + ": " + e.what());
         }
+    }
+
+    // `hf nx ny x0 y0 z0 x1 y1 z1` and nx * ny heights (rows of nx along x,
+    // from y0 to y1), or `hf FILE x0 y0 z0 x1 y1 z1` with the heights read
+    // from an image's first channel (top row at y1). A height h in [0, 1]
+    // lies at z0 + h (z1 - z0). docs/scene-format.md.
+    void height_field() {
+        const std::string_view first = expect_token("height field sample count or image file");
+        long long nx = 0, ny = 0;
+        std::string file;
+        const NumberToken r = parse_int_token(first, nx);
+        if (r == NumberToken::NotNumber) {
+            file = std::string(first);
+        } else {
+            if (r != NumberToken::Ok) fail(tok_.line(), "sample count " + quote_token(first) + " out of range" + where());
+            ny = integer("height field sample count ny");
+            for (const long long n : {nx, ny})
+                if (n < 2 || n > kMaxHeightFieldSide)
+                    fail(tok_.line(), "height field sample count " + std::to_string(n) + " outside [2, " +
+                                          std::to_string(kMaxHeightFieldSide) + "]" + where());
+            if (nx * ny > kMaxHeightFieldSamples)
+                fail(tok_.line(), "height field of " + std::to_string(nx * ny) + " samples exceeds the limit of " +
+                                      std::to_string(kMaxHeightFieldSamples) + where());
+        }
+        HeightField f;
+        f.lo = vec3("height field corner x0 y0 z0");
+        f.hi = vec3("height field corner x1 y1 z1");
+        if (!(f.lo.x < f.hi.x && f.lo.y < f.hi.y))
+            fail(tok_.line(), "height field rectangle is empty (needs x0 < x1 and y0 < y1)" + where());
+        const float z0 = f.lo.z, z1 = f.hi.z;
+        if (file.empty()) {
+            require_memory(std::uint64_t(nx) * std::uint64_t(ny) * 12, name_ + ": height field of " +
+                                                                           std::to_string(nx * ny) + " samples");
+            f.nx = std::uint32_t(nx);
+            f.ny = std::uint32_t(ny);
+            f.z.resize(std::size_t(nx * ny));
+            for (float& z : f.z) z = z0 + number("height") * (z1 - z0);
+        } else {
+            read_height_image(file, f);
+            for (float& z : f.z) z = z0 + z * (z1 - z0);
+        }
+        for (const float z : f.z)
+            if (!std::isfinite(z)) fail(entity_line_, "height field height overflows" + where());
+        scene_.add_height_field(std::move(f), material());
+    }
+
+    void read_height_image(const std::string& file, HeightField& f) {
+        std::filesystem::path path(file);
+        if (path.is_relative() && !name_.starts_with("gen:")) path = std::filesystem::path(name_).parent_path() / path;
+        const HeightImageReader& reader = height_image_reader();
+        if (!reader) fail(entity_line_, "hf " + quote_token(file) + ": no image reader in this program");
+        std::uint32_t w = 0, h = 0;
+        std::vector<float> pixels;
+        try {
+            pixels = reader(path.string(), w, h);
+        } catch (const std::exception& e) {
+            fail(entity_line_, "hf " + quote_token(file) + ": " + e.what());
+        }
+        if (w < 2 || h < 2 || w > kMaxHeightFieldSide || h > kMaxHeightFieldSide)
+            fail(entity_line_, "hf " + quote_token(file) + ": image of " + std::to_string(w) + " x " +
+                                   std::to_string(h) + " pixels (each side must be in [2, " +
+                                   std::to_string(kMaxHeightFieldSide) + "])");
+        f.nx = w;
+        f.ny = h;
+        f.z.resize(std::size_t(w) * h);
+        for (std::uint32_t j = 0; j < h; ++j)  // image rows run from the top, y1, down
+            for (std::uint32_t i = 0; i < w; ++i) f.z[std::size_t(j) * w + i] = pixels[std::size_t(h - 1 - j) * w + i];
+        for (const float z : f.z)
+            if (!std::isfinite(z)) fail(entity_line_, "hf " + quote_token(file) + ": non-finite pixel value");
     }
 
     void lens() {

@@ -60,11 +60,20 @@ std::uint32_t Scene::add_cone(const Vec3f& base, float base_r, const Vec3f& apex
     return std::uint32_t(prims.size() - 1);
 }
 
+std::uint32_t Scene::add_height_field(HeightField field, std::uint32_t material) {
+    field.build_ranges();
+    height_fields.push_back(std::move(field));
+    prims.push_back({PrimKind::HeightField, std::uint32_t(height_fields.size() - 1)});
+    prim_material.push_back(material);
+    return std::uint32_t(prims.size() - 1);
+}
+
 void Scene::update_features() {
     Features f;
     f.spheres = spheres.size() > 0;
     f.triangles = triangles.size() > 0;
     f.cones = cones.size() > 0;
+    f.height_fields = !height_fields.empty();
     for (auto h : triangles.has_normals) f.vertex_normals |= h != 0;
     for (auto h : spheres.inside_only) f.inside_only |= h != 0;
     for (auto h : cones.inside_only) f.inside_only |= h != 0;
@@ -107,6 +116,10 @@ Box3f primitive_bounds(const Scene& s, std::uint32_t prim) {
             b.extend(s.triangles.p0[i]);
             b.extend(s.triangles.p1[i]);
             b.extend(s.triangles.p2[i]);
+            break;
+        case PrimKind::HeightField:
+            b.extend(s.height_fields[i].lo);
+            b.extend(s.height_fields[i].hi);
             break;
         case PrimKind::Cone: {
             // Each end is a disc; its box extent along axis a is r * sqrt(1 - n_a^2).

@@ -6,10 +6,11 @@
 #include <vector>
 
 #include "kernels/aabb.h"
+#include "kernels/height_field.h"
 
 namespace raypack {
 
-enum class PrimKind : std::uint8_t { Sphere, Triangle, Cone };
+enum class PrimKind : std::uint8_t { Sphere, Triangle, Cone, HeightField };
 
 /// Scene-global primitive number -> kind and index into that kind's arrays.
 struct PrimRef {
@@ -111,6 +112,7 @@ struct Features {
     bool spheres = false;
     bool triangles = false;
     bool cones = false;
+    bool height_fields = false;
     bool vertex_normals = false;
     bool reflection = false;    ///< some material has Ks > 0
     bool transmission = false;  ///< some material has T > 0
@@ -135,6 +137,8 @@ struct Scene {
     SphereSoA spheres;
     TriangleSoA triangles;
     ConeSoA cones;
+    /// NFF extension `hf`: each field is one primitive (kernels/height_field.h).
+    std::vector<HeightField> height_fields;
 
     std::vector<PrimRef> prims;                ///< global number -> kind, index
     std::vector<std::uint32_t> prim_material;  ///< global number -> materials[]
@@ -154,6 +158,8 @@ struct Scene {
                                const Vec3f& nb, const Vec3f& nc, std::uint32_t material);
     std::uint32_t add_cone(const Vec3f& base, float base_r, const Vec3f& apex, float apex_r,
                            std::uint32_t material);
+    /// Takes the samples; builds the field's min/max pyramid.
+    std::uint32_t add_height_field(HeightField field, std::uint32_t material);
     /// Room for `more` triangles, so that a loader that knows how many
     /// follow does not grow the arrays by copying (fresh pages cost more
     /// than the copies on the measured machines).

@@ -105,6 +105,7 @@ std::vector<Rayf> test_rays(const Scene& scene, const Bvh2& bvh) {
                 return p;
             }
             case PrimKind::Cone: return scene.cones.apex[ref.index];
+            case PrimKind::HeightField: return scene.height_fields[ref.index].peak();
         }
         return box.center();
     };

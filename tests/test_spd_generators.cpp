@@ -195,7 +195,8 @@ TEST(SpdGenerators, ListsGeneratorsWithDefaults) {
     EXPECT_EQ(defaults["gears"], 4);
     EXPECT_EQ(defaults["teapot"], 6);
     EXPECT_EQ(defaults["cornell"], 1);
-    EXPECT_EQ(gens.size(), 8u);
+    EXPECT_EQ(defaults["terrain"], 9);
+    EXPECT_EQ(gens.size(), 9u);
 }
 
 TEST(SpdGenerators, RejectsUnknownNamesAndBadSizes) {
@@ -240,6 +241,7 @@ TEST(SpdGenerators, SizesStopAtWhatTheStructuresAddress) {
     EXPECT_EQ(max["mount"], 13);
     EXPECT_EQ(max["balls"], 9);
     EXPECT_EQ(max["cornell"], 2);
+    EXPECT_EQ(max["terrain"], 13);  // (2^13 + 1)^2 samples, under the 2^28 an `hf` may have
 }
 
 TEST(SpdGenerators, MountAboveItsOriginalRangeIsDefined) {

@@ -18,21 +18,23 @@
 namespace raypack {
 
 /// A child slot: an inner node index, or a leaf (top bit set) naming a run of
-/// leaf blocks. Leaf bits: 30..29 kind (a PrimKind, or kMixed), 28..26
+/// leaf blocks. Leaf bits: 30..28 kind (a PrimKind, or kMixed), 27..26
 /// blocks - 1, 25..0 first block (for kMixed: the index into WideBvh::mixed).
 namespace wide_child {
 inline constexpr std::uint32_t kLeafBit = 0x80000000u;
 inline constexpr std::uint32_t kEmpty = 0xFFFFFFFFu;  ///< unused slot (its box is empty)
-inline constexpr int kKindShift = 29, kCountShift = 26;
+inline constexpr int kKindShift = 28, kCountShift = 26;
 inline constexpr std::uint32_t kIndexMask = (1u << kCountShift) - 1u;
-inline constexpr std::uint32_t kMaxBlocks = 8;
+/// More blocks of one kind (a leaf of more than 4 M primitives, which only
+/// unsplittable subtrees make) go through a mixed leaf.
+inline constexpr std::uint32_t kMaxBlocks = 4;
 
 RAYPACK_INLINE bool is_leaf(std::uint32_t c) { return (c & kLeafBit) != 0; }
 /// The kind of a leaf holding several kinds, or more blocks than a slot names.
 inline constexpr std::uint32_t kMixed = kPrimKinds;
-static_assert(kMixed <= 3, "the kind field has two bits");
-RAYPACK_INLINE std::uint32_t kind(std::uint32_t c) { return (c >> kKindShift) & 3u; }
-RAYPACK_INLINE std::uint32_t blocks(std::uint32_t c) { return ((c >> kCountShift) & 7u) + 1u; }
+static_assert(kMixed <= 7, "the kind field has three bits");
+RAYPACK_INLINE std::uint32_t kind(std::uint32_t c) { return (c >> kKindShift) & 7u; }
+RAYPACK_INLINE std::uint32_t blocks(std::uint32_t c) { return ((c >> kCountShift) & 3u) + 1u; }
 RAYPACK_INLINE std::uint32_t first(std::uint32_t c) { return c & kIndexMask; }
 inline std::uint32_t make_leaf(std::uint32_t k, std::uint32_t first_block, std::uint32_t block_count) {
     return kLeafBit | (std::uint32_t(k) << kKindShift) | ((block_count - 1u) << kCountShift) | first_block;
@@ -65,7 +67,7 @@ static_assert(sizeof(WideNode<4>) == 128 && sizeof(WideNode<8>) == 256);
 struct MixedLeaf {
     std::uint32_t first[kPrimKinds];
     std::uint32_t count[kPrimKinds];
-};  // total: 24 bytes
+};  // total: 8 bytes a kind
 
 /// Cache-line aligned storage through the aligned global `operator new`
 /// (which raypack's command line replaces to ask for huge pages for large

@@ -38,6 +38,7 @@ struct PrimitiveBoxOverlap {
                 return d2 <= r * r;
             }
             case PrimKind::Cone:
+            case PrimKind::HeightField:
                 return true;  // the caller has already intersected the bounding boxes
         }
         return true;

@@ -16,6 +16,7 @@
 #include <type_traits>
 
 #include "accel/prims/cone_prims.h"
+#include "accel/prims/height_field_prims.h"
 #include "accel/prims/sphere_prims.h"
 #include "accel/prims/triangle_prims.h"
 
@@ -57,7 +58,7 @@ struct KindList {
 };
 
 /// The kinds in the order a mixed leaf tests its runs.
-using PrimKinds = KindList<TrianglePrims, SpherePrims, ConePrims>;
+using PrimKinds = KindList<TrianglePrims, SpherePrims, ConePrims, HeightFieldPrims>;
 inline constexpr int kPrimKinds = PrimKinds::size;
 
 }  // namespace raypack

@@ -15,5 +15,8 @@ std::string generate_gears(int size);
 std::string generate_teapot(int size);
 /// Not an SPD scene: the Cornell box (size 1 with its blocks, 2 with spheres).
 std::string generate_cornell(int size);
+/// Not an SPD scene: mount's mountain as one height field of (2^size + 1)^2
+/// samples (raypack's `hf`), with mount's spheres, view and light.
+std::string generate_terrain(int size);
 
 }  // namespace raypack::spd

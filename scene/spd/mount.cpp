@@ -4,6 +4,7 @@
 // database: its hash repeats itself, but the published image uses it.
 #include <array>
 #include <cmath>
+#include <vector>
 
 #include "scene/spd/generators.h"
 #include "scene/spd/nff_writer.h"
@@ -81,18 +82,13 @@ double displacement(const MountainGrid& g, int x, int y) {
     return gauss_rand(seed);
 }
 
-/// The square of WIDTH cells with lower-left grid point (x, y): two
-/// triangles when it is one cell, else four displaced quarter squares.
-void grow_mountain(NffWriter& out, const MountainGrid& g, int width, int x, int y, const Corners& z) {
+/// The square of WIDTH cells with lower-left grid point (x, y): one cell
+/// goes to `cell(x, y, corners)`, a larger square to its four displaced
+/// quarter squares.
+template <class Cell>
+void grow_mountain(const MountainGrid& g, int width, int x, int y, const Corners& z, Cell&& cell) {
     if (width == 1) {
-        const double lx = kCornerX + static_cast<double>(x) * kWidth / g.points;
-        const double rx = kCornerX + static_cast<double>(x + 1) * kWidth / g.points;
-        const double ly = kCornerY + static_cast<double>(y) * kWidth / g.points;
-        const double uy = kCornerY + static_cast<double>(y + 1) * kWidth / g.points;
-        const std::array<Vec3, 4> quad = {Vec3{lx, ly, z.ll}, Vec3{rx, ly, z.lr}, Vec3{rx, uy, z.ur},
-                                          Vec3{lx, uy, z.ul}};
-        out.polygon(std::array<Vec3, 3>{quad[0], quad[1], quad[2]});
-        out.polygon(std::array<Vec3, 3>{quad[2], quad[3], quad[0]});
+        cell(x, y, z);
         return;
     }
 
@@ -106,15 +102,32 @@ void grow_mountain(NffWriter& out, const MountainGrid& g, int width, int x, int 
     const double left = (z.ul + z.ll) / 2.0 + rise * displacement(g, x, y + half);
     const double middle = (z.ll + z.lr + z.ur + z.ul) / 4.0 + 1.4142136 * rise * displacement(g, x + half, y + half);
 
-    grow_mountain(out, g, half, x, y, {z.ll, lower, middle, left});
-    grow_mountain(out, g, half, x + half, y, {lower, z.lr, right, middle});
-    grow_mountain(out, g, half, x + half, y + half, {middle, right, z.ur, upper});
-    grow_mountain(out, g, half, x, y + half, {left, middle, upper, z.ul});
+    grow_mountain(g, half, x, y, {z.ll, lower, middle, left}, cell);
+    grow_mountain(g, half, x + half, y, {lower, z.lr, right, middle}, cell);
+    grow_mountain(g, half, x + half, y + half, {middle, right, z.ur, upper}, cell);
+    grow_mountain(g, half, x, y + half, {left, middle, upper, z.ul}, cell);
 }
 
-}  // namespace
+/// One cell of the mountain as SPD writes it: two triangles.
+void mountain_cell(NffWriter& out, const MountainGrid& g, int x, int y, const Corners& z) {
+    const double lx = kCornerX + static_cast<double>(x) * kWidth / g.points;
+    const double rx = kCornerX + static_cast<double>(x + 1) * kWidth / g.points;
+    const double ly = kCornerY + static_cast<double>(y) * kWidth / g.points;
+    const double uy = kCornerY + static_cast<double>(y + 1) * kWidth / g.points;
+    const std::array<Vec3, 4> quad = {Vec3{lx, ly, z.ll}, Vec3{rx, ly, z.lr}, Vec3{rx, uy, z.ur}, Vec3{lx, uy, z.ul}};
+    out.polygon(std::array<Vec3, 3>{quad[0], quad[1], quad[2]});
+    out.polygon(std::array<Vec3, 3>{quad[2], quad[3], quad[0]});
+}
 
-std::string generate_mount(int size) {
+MountainGrid mountain_grid(int size) {
+    // Per-level scale ratio 2^(1/(D-1)) gives fractal dimension D.
+    const double ratio = 2.0 / std::exp(std::log(2.0) / (kFractalDimension - 1.0));
+    return {size, static_cast<double>(1 << size), std::sqrt(ratio * ratio - 1.0)};
+}
+
+/// What mount and terrain share: sky, view, light, the crystal spheres, and
+/// the mountain's material.
+NffWriter mountain_setting() {
     NffWriter out;
     out.background({0.078, 0.361, 0.753});
     out.viewpoint({-1.6, 1.6, 1.7}, {0.0, 0.0, 0.0}, {0.0, 0.0, 1.0}, 45.0, 0.01, 512, 512);
@@ -126,11 +139,32 @@ std::string generate_mount(int size) {
 
     // Grey mountain.
     out.surface({0.5, 0.45, 0.35}, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0);
-    const int points = 1 << size;
-    // Per-level scale ratio 2^(1/(D-1)) gives fractal dimension D.
-    const double ratio = 2.0 / std::exp(std::log(2.0) / (kFractalDimension - 1.0));
-    const MountainGrid grid{size, static_cast<double>(points), std::sqrt(ratio * ratio - 1.0)};
-    grow_mountain(out, grid, points, 0, 0, {0.0, 0.0, 0.0, 0.0});
+    return out;
+}
+
+}  // namespace
+
+std::string generate_mount(int size) {
+    NffWriter out = mountain_setting();
+    const MountainGrid grid = mountain_grid(size);
+    grow_mountain(grid, 1 << size, 0, 0, {0.0, 0.0, 0.0, 0.0},
+                  [&](int x, int y, const Corners& z) { mountain_cell(out, grid, x, y, z); });
+    return out.take();
+}
+
+std::string generate_terrain(int size) {
+    NffWriter out = mountain_setting();
+    const MountainGrid grid = mountain_grid(size);
+    const int n = (1 << size) + 1;  // samples per side
+    std::vector<double> heights(std::size_t(n) * std::size_t(n));
+    grow_mountain(grid, 1 << size, 0, 0, {0.0, 0.0, 0.0, 0.0}, [&](int x, int y, const Corners& z) {
+        heights[std::size_t(y) * n + x] = z.ll;
+        heights[std::size_t(y) * n + x + 1] = z.lr;
+        heights[std::size_t(y + 1) * n + x + 1] = z.ur;
+        heights[std::size_t(y + 1) * n + x] = z.ul;
+    });
+    // Heights mapped by z0 = 0, z1 = 1: as written, the mountain's own.
+    out.height_field(n, n, {kCornerX, kCornerY, 0.0}, {kCornerX + kWidth, kCornerY + kWidth, 1.0}, heights);
     return out.take();
 }
 

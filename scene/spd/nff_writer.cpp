@@ -45,6 +45,21 @@ void NffWriter::vec(const Vec3& v) {
     number(v.z);
 }
 
+void NffWriter::height_field(int nx, int ny, const Vec3& lo, const Vec3& hi, std::span<const double> heights) {
+    text_ += "hf " + std::to_string(nx) + ' ' + std::to_string(ny) + ' ';
+    vec(lo);
+    text_ += ' ';
+    vec(hi);
+    text_ += '\n';
+    for (int j = 0; j < ny; ++j) {
+        for (int i = 0; i < nx; ++i) {
+            if (i) text_ += ' ';
+            number(heights[std::size_t(j) * std::size_t(nx) + std::size_t(i)]);
+        }
+        text_ += '\n';
+    }
+}
+
 void NffWriter::background(const Vec3& color) {
     text_ += "b ";
     vec(color);

@@ -33,6 +33,9 @@ public:
     /// Triangle with per-vertex normals ("pp 3"). The SPD library sends
     /// patches through its triangle splitter, which does no duplicate check.
     void triangle_patch(const std::array<Vec3, 3>& vertices, const std::array<Vec3, 3>& normals);
+    /// raypack's `hf nx ny x0 y0 z0 x1 y1 z1` and its nx * ny heights, one
+    /// row of nx a line (not SPD: docs/scene-format.md).
+    void height_field(int nx, int ny, const Vec3& lo, const Vec3& hi, std::span<const double> heights);
 
     const std::string& text() const { return text_; }
     std::string take() { return std::move(text_); }

@@ -18,6 +18,8 @@ struct Entry {
     int limit;  ///< the generator's own largest size (its arithmetic), or 0
     std::string (*generate)(int size);
     double (*primitives)(int size);  ///< primitives as loaded (polygons as triangles)
+    /// Bytes budgeted for loading and tracing it; nullptr: kSpdBytesPerPrimitive a primitive.
+    double (*bytes)(int size) = nullptr;
 };
 
 double power(double base, int exponent) {
@@ -39,6 +41,10 @@ constexpr Entry kGenerators[] = {
     {"gears", 4, 0, spd::generate_gears, [](int n) { return 572.0 * n * n * n + 2.0; }},
     {"teapot", 6, 0, spd::generate_teapot, [](int n) { return 66.0 * n * n - 8.0 * n; }},
     {"cornell", 1, 2, spd::generate_cornell, [](int n) { return n == 1 ? 32.0 : 14.0; }},
+    // One field of (2^n + 1)^2 samples and mount's 4 spheres; its memory
+    // is per sample (text, floats, pyramid: ~40 bytes), not per primitive.
+    {"terrain", 9, 13, spd::generate_terrain, [](int) { return 5.0; },
+     [](int n) { return 40.0 * (power(2, n) + 1.0) * (power(2, n) + 1.0); }},
 };
 
 /// The largest size whose scene raypack can address.
@@ -82,7 +88,7 @@ std::string generate_spd(std::string_view name, int size) {
                                                                         " primitives)"
                                                                   : ""));
         const auto prims = std::uint64_t(e.primitives(size));
-        require_memory(prims * kSpdBytesPerPrimitive,
+        require_memory(e.bytes ? std::uint64_t(e.bytes(size)) : prims * kSpdBytesPerPrimitive,
                        std::string(name) + " size " + std::to_string(size) + " (" + std::to_string(prims) +
                            " primitives)");
         return e.generate(size);

@@ -1,0 +1,24 @@
+#include "app/scene_options.h"
+
+#include "scene/height_field_mesh.h"
+#include "scene/load.h"
+
+namespace raypack::app {
+
+OptionSpec scene_option_spec() { return {"--heightfield-as", "", 1}; }
+
+Scene load_scene_from(const ParsedArgs& args, const std::string& spec) {
+    const std::string as = args.has("--heightfield-as") ? args.text("--heightfield-as") : "field";
+    if (as != "field" && as != "triangles")
+        throw UsageError("--heightfield-as: expected field or triangles, got '" + as + "'");
+    Scene scene = load_scene(spec);
+    if (as == "triangles") scene = height_fields_as_triangles(scene);
+    return scene;
+}
+
+std::string scene_option_help() {
+    return "  --heightfield-as field|triangles  height fields traced directly (default), or loaded as\n"
+           "                 2 (nx-1)(ny-1) triangles each, for comparison\n";
+}
+
+}  // namespace raypack::app
