@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <stdexcept>
 #include <vector>
 
 #include "kernels/ray.h"
@@ -23,10 +24,12 @@ struct HeightField {
     std::vector<float> z;
     /// Level l = 1, 2, ... of the min/max pyramid: cell (a, b) covers level-0
     /// cells [a 2^l, (a + 1) 2^l) x [b 2^l, (b + 1) 2^l); stored as (min,
-    /// max) pairs, row-major, level_w[l] x level_h[l] cells. Level 0 (one
-    /// cell) is read from the samples. The last level has one cell.
-    std::vector<std::vector<float>> range;
-    std::vector<std::uint32_t> level_w, level_h;
+    /// max) pairs, row-major, level_w[l] x level_h[l] cells from
+    /// range[level_offset[l]] on (one array, so that lanes gather from it).
+    /// Level 0 (one cell) is read from the samples. The last level has one
+    /// cell.
+    std::vector<float> range;
+    std::vector<std::uint32_t> level_w, level_h, level_offset;
 
     std::uint32_t cells_x() const { return nx - 1; }
     /// The highest sample as a point: it lies on the field's bounding box.
@@ -38,9 +41,8 @@ struct HeightField {
     std::uint32_t cells_y() const { return ny - 1; }
     float sample(std::uint32_t i, std::uint32_t j) const { return z[std::size_t(j) * nx + i]; }
     std::size_t bytes() const {
-        std::size_t b = z.size() * sizeof(float);
-        for (const auto& r : range) b += r.size() * sizeof(float);
-        return b;
+        return (z.size() + range.size()) * sizeof(float) +
+               (level_w.size() + level_h.size() + level_offset.size()) * sizeof(std::uint32_t);
     }
     /// Fills `range`, level_w, level_h, lo.z and hi.z from the samples.
     void build_ranges();
@@ -48,18 +50,21 @@ struct HeightField {
 
 inline void HeightField::build_ranges() {
     const std::uint32_t cx = cells_x(), cy = cells_y();
-    range.assign(1, {});  // level 0 is read from the samples
+    range.clear();  // level 0 is read from the samples
     level_w.assign(1, cx);
     level_h.assign(1, cy);
+    level_offset.assign(1, 0);
     auto [zmin, zmax] = std::minmax_element(z.begin(), z.end());
     lo.z = *zmin;
     hi.z = *zmax;
     std::uint32_t w = cx, h = cy;
     for (int l = 1; w > 1 || h > 1; ++l) {
-        const std::uint32_t pw = w, ph = h;
+        const std::uint32_t pw = w, ph = h, previous = level_offset.back();
         w = (w + 1) / 2;
         h = (h + 1) / 2;
-        std::vector<float> r(std::size_t(w) * h * 2);
+        const std::size_t base = range.size();
+        if (base + std::size_t(w) * h * 2 > 0xFFFFFFFFu) throw std::length_error("height field pyramid too large");
+        range.resize(base + std::size_t(w) * h * 2);
         for (std::uint32_t b = 0; b < h; ++b)
             for (std::uint32_t a = 0; a < w; ++a) {
                 float mn = std::numeric_limits<float>::infinity(), mx = -mn;
@@ -72,19 +77,19 @@ inline void HeightField::build_ranges() {
                             cmn = std::min(std::min(h00, h10), std::min(h01, h11));
                             cmx = std::max(std::max(h00, h10), std::max(h01, h11));
                         } else {
-                            const float* p = &range[l - 1][(std::size_t(j) * pw + i) * 2];
+                            const float* p = &range[previous + (std::size_t(j) * pw + i) * 2];
                             cmn = p[0];
                             cmx = p[1];
                         }
                         mn = std::min(mn, cmn);
                         mx = std::max(mx, cmx);
                     }
-                r[(std::size_t(b) * w + a) * 2] = mn;
-                r[(std::size_t(b) * w + a) * 2 + 1] = mx;
+                range[base + (std::size_t(b) * w + a) * 2] = mn;
+                range[base + (std::size_t(b) * w + a) * 2 + 1] = mx;
             }
-        range.push_back(std::move(r));
         level_w.push_back(w);
         level_h.push_back(h);
+        level_offset.push_back(std::uint32_t(base));
     }
 }
 

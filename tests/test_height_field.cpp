@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -15,6 +16,7 @@
 
 #include "accel/accel.h"
 #include "accel/brute/brute_force.h"
+#include "kernels/height_field_walk.h"
 #include "oracle_harness.h"
 #include "render/image.h"
 #include "scene/height_field_mesh.h"
@@ -213,6 +215,48 @@ TEST(HeightField, WalkAgreesWithDoubleReference) {
         EXPECT_GT(hits, 400) << c.name;  // the rays do reach the surface
         EXPECT_LT(marginal, 40) << c.name << ": " << first_marginal;
     }
+}
+
+template <int K>
+void expect_lanes_equal_scalar() {
+    // The lockstep walk of K rays gives each lane the scalar walk's bits.
+    using F = vfloat<K>;
+    for (const FieldCase& c : field_cases()) {
+        std::mt19937 rng(17);
+        const std::vector<Rayf> rays = rays_at(c.field, rng, 64 * K);
+        int hits = 0;
+        for (std::size_t first = 0; first < rays.size(); first += K) {
+            alignas(64) float ox[K], oy[K], oz[K], dx[K], dy[K], dz[K], tn[K], tf[K], on[K];
+            for (int k = 0; k < K; ++k) {
+                const Rayf& r = rays[first + k];
+                ox[k] = r.org.x, oy[k] = r.org.y, oz[k] = r.org.z, dx[k] = r.dir.x, dy[k] = r.dir.y, dz[k] = r.dir.z;
+                tn[k] = r.tnear, tf[k] = r.tfar, on[k] = k % 5 == 4 ? 0.0f : 1.0f;  // some lanes off
+            }
+            const mask_of<F> active = F::load_aligned(on) > F(0.0f);
+            const Vec3<F> org{F::load_aligned(ox), F::load_aligned(oy), F::load_aligned(oz)};
+            const Vec3<F> dir{F::load_aligned(dx), F::load_aligned(dy), F::load_aligned(dz)};
+            F t(-1.0f), u(-1.0f), v(-1.0f);
+            const std::uint32_t bits = mask_bits(intersect_height_field_lanes<F>(
+                c.field, active, org, dir, F::load_aligned(tn), F::load_aligned(tf), t, u, v));
+            for (int k = 0; k < K; ++k) {
+                float ts = -1, us = -1, vs = -1;
+                const bool want = on[k] != 0 && intersect_height_field(c.field, rays[first + k], ts, us, vs);
+                ASSERT_EQ(((bits >> k) & 1u) != 0, want) << c.name << " " << describe(rays[first + k]);
+                if (!want) continue;
+                ++hits;
+                EXPECT_EQ(std::bit_cast<std::uint32_t>(lane(t, k)), std::bit_cast<std::uint32_t>(ts)) << c.name;
+                EXPECT_EQ(lane(u, k), us) << c.name;
+                EXPECT_EQ(lane(v, k), vs) << c.name;
+            }
+        }
+        EXPECT_GT(hits, 8 * K) << c.name;
+    }
+}
+
+TEST(HeightField, LanesEqualScalarWalk) {
+    if constexpr (kWidthCompiled<4>) expect_lanes_equal_scalar<4>();
+    if constexpr (kWidthCompiled<8>) expect_lanes_equal_scalar<8>();
+    if constexpr (kWidthCompiled<16>) expect_lanes_equal_scalar<16>();
 }
 
 TEST(HeightField, HitPositionAndNormalAreThePatchs) {

@@ -1,9 +1,11 @@
 #pragma once
-// Height fields as a leaf primitive kind: a block names up to M fields, and
-// every form of the test runs the scalar walk of kernels/height_field.h per
-// (ray, field) pair: the walk's cost is its cells, not the lane shuffling.
+// Height fields as a leaf primitive kind: a block names up to M fields. One
+// ray against a block walks each field in turn (the scalar walk); K rays
+// against one field walk it in lockstep, one lane a ray
+// (kernels/height_field_walk.h).
 #include <cstdint>
 #include <span>
+#include <type_traits>
 
 #include "accel/kernel_choice.h"
 #include "accel/prims/leaf_common.h"
@@ -62,24 +64,17 @@ struct HeightFieldPrims {
     }
 
 private:
+    /// K rays against one field: the lockstep walk (kernels/height_field_walk.h),
+    /// each lane the scalar walk's bits.
     template <class F>
     static mask_of<F> lanes(const HeightField& field, const mask_of<F>& active, const Vec3<F>& org,
                             const Vec3<F>& dir, const F& tnear, const F& tfar, F& t, F& u, F& v) {
-        constexpr int K = lanes_of<F>;
-        alignas(64) float ox[K], oy[K], oz[K], dx[K], dy[K], dz[K], tn[K], tf[K], ts[K], us[K], vs[K], hit[K];
-        store_lanes(ox, org.x), store_lanes(oy, org.y), store_lanes(oz, org.z);
-        store_lanes(dx, dir.x), store_lanes(dy, dir.y), store_lanes(dz, dir.z);
-        store_lanes(tn, tnear), store_lanes(tf, tfar);
-        store_lanes(ts, t), store_lanes(us, u), store_lanes(vs, v);
-        const std::uint32_t bits = mask_bits(active);
-        for (int k = 0; k < K; ++k) {
-            hit[k] = 0.0f;
-            if (!((bits >> k) & 1u)) continue;
-            const Rayf ray{{ox[k], oy[k], oz[k]}, {dx[k], dy[k], dz[k]}, tn[k], tf[k]};
-            if (intersect_height_field(field, ray, ts[k], us[k], vs[k])) hit[k] = 1.0f;
+        if constexpr (std::is_floating_point_v<F>) {
+            if (!active) return false;
+            return intersect_height_field(field, Rayf{org, dir, tnear, tfar}, t, u, v);
+        } else {
+            return intersect_height_field_lanes<F>(field, active, org, dir, tnear, tfar, t, u, v);
         }
-        t = load_lanes<F>(ts), u = load_lanes<F>(us), v = load_lanes<F>(vs);
-        return load_lanes<F>(hit) > F(0.0f);
     }
 };
 
