@@ -1,6 +1,7 @@
 // NFF (Haines, "Neutral File Format", scenes/nff-format.txt) as a stream of
 // whitespace-separated tokens, so that the one-line cone the SPD programs
 // write and the three-line cone the format document shows both load.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <iterator>
@@ -335,8 +336,10 @@ private:
                                                                            std::to_string(nx * ny) + " samples");
             f.nx = std::uint32_t(nx);
             f.ny = std::uint32_t(ny);
-            f.z.resize(std::size_t(nx * ny));
-            for (float& z : f.z) z = z0 + number("height") * (z1 - z0);
+            // Grown as the heights arrive: a count far beyond the text (a
+            // truncated or hostile file) fails at its end, not at a huge allocation.
+            f.z.reserve(std::size_t(std::min<long long>(nx * ny, 1 << 20)));
+            for (long long k = 0; k < nx * ny; ++k) f.z.push_back(z0 + number("height") * (z1 - z0));
         } else {
             read_height_image(file, f);
             for (float& z : f.z) z = z0 + z * (z1 - z0);
