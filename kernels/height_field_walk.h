@@ -113,7 +113,9 @@ bool intersect_height_field(const HeightField& f, const Ray<T>& ray, T& t_out, T
         t0 = std::max(t0, ta);
         t1 = std::min(t1, tb);
     }
-    if (!(t0 <= t1)) return false;
+    // A span that starts at infinity (tnear = -inf and no direction to clip
+    // it) places the ray nowhere: no hit.
+    if (!(t0 <= t1) || !(std::abs(t0) < inf)) return false;
     // Widen t1 a little so that a hit on the box's far face is not lost to
     // the rounding of the span.
     t1 = std::min(ray.tfar, t1 + (std::abs(t1) + std::abs(t0)) * eps * T(16));
@@ -289,7 +291,7 @@ mask_of<F> intersect_height_field_lanes(const HeightField& f, mask_of<F> active,
     clip(org.x, dir.x, lo_x, hi_x);
     clip(org.y, dir.y, lo_y, hi_y);
     clip(org.z, dir.z, lo_z, hi_z);
-    active = active & (t0 <= t1);
+    active = active & (t0 <= t1) & (vabs(t0) < inf);
     if (none(active)) return active;
     t1 = vmin_like_std(tfar, t1 + (vabs(t1) + vabs(t0)) * F(eps) * F(16.0f));
     const float inv_sx = 1.0f / sx, inv_sy = 1.0f / sy;

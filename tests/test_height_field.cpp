@@ -10,6 +10,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -123,6 +124,10 @@ std::vector<Rayf> rays_at(const HeightField& f, std::mt19937& rng, int n) {
         if (k % 5 == 2) r.dir.x = r.dir.y = 0.0f;
         if (!(dot(r.dir, r.dir) > 0)) r.dir = {0, 0, -1};
         if (k % 7 == 0) r.tfar = u(rng) * 1.5f;
+        // What a .rays file may hold: an unbounded interval both ways, a zero direction.
+        if (k % 97 == 5) r.tnear = -std::numeric_limits<float>::infinity();
+        if (k % 97 == 6) r.dir = {0, 0, 0};
+        if (k % 97 == 7) r.tnear = -std::numeric_limits<float>::infinity(), r.dir = {0, 0, 0};
         rays.push_back(r);
     }
     return rays;
