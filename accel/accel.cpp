@@ -38,7 +38,62 @@ std::span<const char* const> accel_kinds() {
 
 std::string accel_kinds_list() { return names_joined(accel_kinds()); }
 
+namespace {
+
+/// A scene with instances: the structures of its objects (built first, in
+/// definition order, so that an object's own instances find theirs) and the
+/// structure over the scene, whose instance primitives point to them. The
+/// queries are the top structure's.
+class InstancedAccel final : public Accel {
+public:
+    InstancedAccel(std::unique_ptr<ObjectAccels> objects, std::unique_ptr<Accel> top)
+        : objects_(std::move(objects)), top_(std::move(top)), stats_(top_->stats()) {
+        for (const auto& o : objects_->accels) {
+            stats_.bytes += o->stats().bytes;
+            stats_.build_ms += o->stats().build_ms;
+        }
+    }
+    void intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const override { top_->intersect(rays, hits); }
+    void occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override {
+        top_->occluded(rays, occluded);
+    }
+    const AccelStats& stats() const override { return stats_; }
+    bool supports_packet(int width) const override { return top_->supports_packet(width); }
+    void intersect_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const override {
+        top_->intersect_packets(width, rays, hits);
+    }
+    void occluded_packets(int width, std::span<const Rayf> rays, std::span<std::uint8_t> out) const override {
+        top_->occluded_packets(width, rays, out);
+    }
+    bool count_traversal(std::span<const Rayf> rays, bool any_hit, std::span<Hitf> hits,
+                         TraversalCounts& counts) const override {
+        return top_->count_traversal(rays, any_hit, hits, counts);
+    }
+
+private:
+    std::unique_ptr<ObjectAccels> objects_;
+    std::unique_ptr<Accel> top_;
+    AccelStats stats_;
+};
+
+std::unique_ptr<Accel> build_one(const Scene& scene, const AccelConfig& config);
+
+}  // namespace
+
 std::unique_ptr<Accel> build_accel(const Scene& scene, const AccelConfig& config) {
+    // Embree refuses instances itself.
+    if (scene.instances.empty() || is_embree_kind(config.kind)) return build_one(scene, config);
+    auto objects = std::make_unique<ObjectAccels>();
+    AccelConfig with_objects = config;
+    with_objects.kernels.objects = objects.get();
+    for (const auto& object : scene.objects) objects->accels.push_back(build_one(*object, with_objects));
+    auto top = build_one(scene, with_objects);
+    return std::make_unique<InstancedAccel>(std::move(objects), std::move(top));
+}
+
+namespace {
+
+std::unique_ptr<Accel> build_one(const Scene& scene, const AccelConfig& config) {
     if (config.kind == "bvh2") return std::make_unique<Bvh2Accel>(scene, config);
 #if defined(__SSE4_2__)
     if (config.kind == "bvh4") return std::make_unique<Bvh4Accel>(scene, config);
@@ -56,5 +111,7 @@ std::unique_ptr<Accel> build_accel(const Scene& scene, const AccelConfig& config
 #endif
     throw std::invalid_argument("unknown acceleration structure '" + config.kind + "' (expected " + accel_kinds_list() + ")");
 }
+
+}  // namespace
 
 }  // namespace raypack

@@ -7,6 +7,8 @@
 
 namespace raypack {
 
+struct ObjectAccels;
+
 /// Arithmetic of the primitive tests (`--precision`): float, or double on
 /// the float ray and scene converted exactly (the closest hit is still kept
 /// as a float t). Traversal stays float; with robust slabs it never culls a
@@ -21,6 +23,11 @@ struct KernelChoice {
     SlabMethod slabs = SlabMethod::Robust;
     RcpMethod rcp = RcpMethod::Exact;
     Precision precision = Precision::Float;
+    /// Not a choice but where the instance test finds the structures of the
+    /// scene's objects (accel/prims/instance_prims.h): set by build_accel for
+    /// a scene with instances, carried with the kernels because every leaf
+    /// test receives them.
+    const ObjectAccels* objects = nullptr;
 };
 
 }  // namespace raypack

@@ -23,15 +23,25 @@ struct PacketPrimitiveIntersector {
         if (kernels.precision == Precision::Double) return intersect_lanes_in_double(valid, ray, hit, prim);
         const PrimRef ref = scene->prims[prim];
         F t, u(0.0f), v(0.0f);
+        std::uint32_t ids[lanes_of<F>];
+        bool named = false;
         const mask_of<F> m = PrimKinds::dispatch(ref.kind, [&]<class Kind>() RAYPACK_INLINE_LAMBDA {
-            return Kind::template intersect<F>(*scene, ref.index, kernels, valid, ray, t, u, v);
+            if constexpr (names_hits<Kind>) {
+                named = true;
+                return Kind::template intersect<F>(*scene, ref.index, kernels, valid, ray, t, u, v, ids);
+            } else {
+                return Kind::template intersect<F>(*scene, ref.index, kernels, valid, ray, t, u, v);
+            }
         });
         if (none(m)) return m;
         hit.t = select(m, t, hit.t);
         hit.u = select(m, u, hit.u);
         hit.v = select(m, v, hit.v);
         ray.tfar = select(m, t, ray.tfar);
-        for (std::uint32_t bits = mask_bits(m); bits; bits &= bits - 1) hit.prim[std::countr_zero(bits)] = prim;
+        for (std::uint32_t bits = mask_bits(m); bits; bits &= bits - 1) {
+            const int l = std::countr_zero(bits);
+            hit.prim[l] = named ? ids[l] : prim;
+        }
         return m;
     }
 
@@ -55,7 +65,7 @@ private:
             r.org = {ox[l], oy[l], oz[l]}, r.dir = {dx[l], dy[l], dz[l]}, r.tnear = tn[l], r.tfar = tf[l];
             Hitf h;
             if (!single.intersect(prim, r, h)) continue;
-            ht[l] = h.t, hu[l] = h.u, hv[l] = h.v, tf[l] = r.tfar, hit.prim[l] = prim, hitf[l] = 1.0f;
+            ht[l] = h.t, hu[l] = h.u, hv[l] = h.v, tf[l] = r.tfar, hit.prim[l] = h.prim, hitf[l] = 1.0f;
         }
         hit.t = load_lanes<F>(ht), hit.u = load_lanes<F>(hu), hit.v = load_lanes<F>(hv);
         ray.tfar = load_lanes<F>(tf);

@@ -23,14 +23,16 @@ struct PrimitiveIntersector {
             if (kernels.precision == Precision::Double) return intersect_in_double(prim, ray, hit);
         const PrimRef ref = scene->prims[prim];
         T t{}, u{}, v{};
+        std::uint32_t id = prim;
         const bool found = PrimKinds::dispatch(ref.kind, [&]<class Kind>() RAYPACK_INLINE_LAMBDA {
-            return Kind::intersect(*scene, ref.index, kernels, ray, t, u, v);
+            if constexpr (names_hits<Kind>) return Kind::intersect(*scene, ref.index, kernels, ray, t, u, v, id);
+            else return Kind::intersect(*scene, ref.index, kernels, ray, t, u, v);
         });
         if (!found) return false;
         hit.t = t;
         hit.u = u;
         hit.v = v;
-        hit.prim = prim;
+        hit.prim = id;
         ray.tfar = t;
         return true;
     }
@@ -46,7 +48,7 @@ private:
         hit.t = T(h.t);
         hit.u = T(h.u);
         hit.v = T(h.v);
-        hit.prim = prim;
+        hit.prim = h.prim;
         ray.tfar = hit.t;
         return true;
     }

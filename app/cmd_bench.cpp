@@ -217,8 +217,9 @@ int run_bench(const Args& args) {
                                      {"--rays-file", "", 1}, {"--threads", "", 1}, {"--repeat", "", 1},
                                      {"--res", "", 2}, {"--json", "", 1}, {"--csv", "", 1}, {"--quick", "", 0},
                                      {"--tradeoff", "", 0}, {"--builder", "", 1}, {"--embree-quality", "", 1},
-                                     offset_option_spec(), scene_option_spec()};
+                                     offset_option_spec()};
     for (OptionSpec& k : kernel_option_specs()) specs.push_back(std::move(k));
+    for (OptionSpec& k : scene_option_specs()) specs.push_back(std::move(k));
     const ParsedArgs p(args, specs, 1000);
     if (p.help()) {
         print_help();

@@ -13,9 +13,9 @@ void print_vec(const char* label, const Vec3f& v) { std::printf("  %-10s %g %g %
 }  // namespace
 
 int run_info(const Args& args) {
-    const ParsedArgs p(args, {scene_option_spec()}, 1);
+    const ParsedArgs p(args, scene_option_specs(), 1);
     if (p.help() || p.positional().empty()) {
-        std::printf("usage: raypack info SCENE [--heightfield-as field|triangles]\n%s", scene_option_help().c_str());
+        std::printf("usage: raypack info SCENE [--heightfield-as field|triangles] [--instances-as instances|flat]\n%s", scene_option_help().c_str());
         if (!p.help()) throw UsageError("missing SCENE");
         return 0;
     }
@@ -29,6 +29,14 @@ int run_info(const Args& args) {
         for (const HeightField& h : scene.height_fields) samples += h.z.size(), bytes += h.bytes();
         std::printf("  height fields %zu (%zu samples, %.1f MiB with their min/max pyramids)\n",
                     scene.height_fields.size(), samples, double(bytes) / (1 << 20));
+    }
+    if (!scene.instances.empty()) {
+        std::size_t stored = 0;
+        for (const auto& o : scene.objects) stored += o->primitive_count() - o->instances.size();
+        std::printf("  instances  %zu of %zu objects (%zu primitives stored in the objects)\n",
+                    scene.instances.size(), scene.objects.size(), stored);
+        std::printf("primitives as instanced: %llu (with every instance expanded)\n",
+                    static_cast<unsigned long long>(scene.instanced_primitive_count()));
     }
     std::printf("materials: %zu\n", scene.materials.size());
     const Box3f b = scene_bounds(scene);
@@ -71,6 +79,7 @@ int run_info(const Args& args) {
                                                   {f.triangles, "triangles"},
                                                   {f.cones, "cones"},
                                                   {f.height_fields, "height-fields"},
+                                                  {f.instances, "instances"},
                                                   {f.vertex_normals, "vertex-normals"},
                                                   {f.reflection, "reflection"},
                                                   {f.transmission, "transmission"},

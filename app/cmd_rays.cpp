@@ -13,9 +13,10 @@
 namespace raypack::app {
 
 int run_rays(const Args& args) {
-    const ParsedArgs p(args, {{"--kind", "", 1}, {"--res", "", 2}, {"--output", "-o", 1}, {"--seed", "", 1},
-                              offset_option_spec(), scene_option_spec()},
-                       1);
+    std::vector<OptionSpec> spec = {{"--kind", "", 1}, {"--res", "", 2}, {"--output", "-o", 1}, {"--seed", "", 1},
+                                    offset_option_spec()};
+    for (OptionSpec& k : scene_option_specs()) spec.push_back(std::move(k));
+    const ParsedArgs p(args, spec, 1);
     if (p.help() || p.positional().empty()) {
         std::printf(
             "usage: raypack rays SCENE --kind camera|shadow|diffuse [--res W H] [--seed S] [--offset POLICY]\n"

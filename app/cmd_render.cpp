@@ -100,7 +100,8 @@ int run_render(const Args& args) {
                              {"--quiet", "-q", 0}, {"--integrator", "", 1}, {"--spp", "", 1}, {"--sampler", "", 1},
                              {"--seed", "", 1}, {"--light-samples", "", 1}, {"--filter", "", 1},
                              {"--rr-depth", "", 1}, {"--exposure", "", 1}, {"--adaptive", "", 1},
-                             {"--adaptive-depth", "", 1}, scene_option_spec()});
+                             {"--adaptive-depth", "", 1}});
+    for (OptionSpec& k : scene_option_specs()) spec.push_back(std::move(k));
     const ParsedArgs p(args, spec, 1);
     if (p.help() || p.positional().empty()) {
         std::printf(

@@ -47,7 +47,7 @@ double trace_all(const Accel& accel, int packet, const RayFile& file, std::vecto
 
 int run_trace(const Args& args) {
     auto spec = accel_option_specs();
-    spec.push_back(scene_option_spec());
+    for (OptionSpec& k : scene_option_specs()) spec.push_back(std::move(k));
     spec.insert(spec.end(), {{"--rays", "", 1}, {"--output", "-o", 1}, {"--threads", "", 1}, {"--repeat", "", 1},
                              {"--json", "", 0}});
     const ParsedArgs p(args, spec, 1);

@@ -63,7 +63,19 @@ Vec3f offset_ray_origin_robust(const Vec3f& p, const Vec3f& n, float scene_exten
             offset_coordinate(p.z, n.z, scene_extent)};
 }
 
-Vec3f accurate_hit_point(const Scene& scene, const Rayf& ray, const Hitf& hit) {
+namespace {
+
+/// accurate_hit_point in scene `scene` (the top scene or an object) of the
+/// top scene `top`.
+Vec3f point_in(const Scene& top, const Scene& scene, const Rayf& ray, const Hitf& hit) {
+    if (hit.prim >= scene.prims.size()) {
+        // Inside an instance: the point in object space, placed.
+        const Instance& inst = instance_of_hit_id(scene, hit.prim);
+        const Rayf r{inst.to_object.point(ray.org), inst.to_object.vector(ray.dir), ray.tnear, ray.tfar};
+        Hitf h = hit;
+        h.prim -= inst.first_hit_id;
+        return inst.to_world.point(point_in(top, *top.objects[inst.object], r, h));
+    }
     const PrimRef ref = scene.prims[hit.prim];
     const std::uint32_t i = ref.index;
     switch (ref.kind) {
@@ -80,9 +92,16 @@ Vec3f accurate_hit_point(const Scene& scene, const Rayf& ray, const Hitf& hit) {
             return len > 0 ? c + d * (scene.spheres.radius[i] / len) : c + d;
         }
         case PrimKind::HeightField: return height_field_point(scene.height_fields[i], hit.u, hit.v);
-        case PrimKind::Cone: break;
+        case PrimKind::Cone:
+        case PrimKind::Instance: break;
     }
     return ray.org + ray.dir * hit.t;
+}
+
+}  // namespace
+
+Vec3f accurate_hit_point(const Scene& scene, const Rayf& ray, const Hitf& hit) {
+    return point_in(scene, scene, ray, hit);
 }
 
 RayOffset::RayOffset(OffsetPolicy policy, const Scene& scene) : policy_(policy), scene_extent_(1.0f) {

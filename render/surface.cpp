@@ -19,7 +19,29 @@ Vec3f smooth_normal(const TriangleSoA& t, std::uint32_t i, const Hitf& hit, cons
     return length(n) > 0 ? normalize(n) : ng;
 }
 
-Surface surface_at(const Scene& scene, const Rayf& ray, const Hitf& hit) {
+namespace {
+
+/// surface_at in scene `in` (the top scene or an object) of the top scene
+/// `top`; `mirrored`: the instances on the way turn space inside out, so a
+/// triangle's winding normal flips as the flattened triangle's would.
+Surface surface_in(const Scene& top, const Scene& scene, const Rayf& ray, const Hitf& hit, bool mirrored) {
+    if (hit.prim >= scene.prims.size()) {
+        // An instanced primitive: its surface in object space (the ray taken
+        // there as the traversal took it), normals back with the inverse
+        // transpose (Scene::hit_id_count, accel/prims/instance_prims.h).
+        const Instance& inst = instance_of_hit_id(scene, hit.prim);
+        const Rayf r{inst.to_object.point(ray.org), inst.to_object.vector(ray.dir), ray.tnear, ray.tfar};
+        Hitf h = hit;
+        h.prim -= inst.first_hit_id;
+        const bool flip = inst.to_world.determinant() < 0;
+        const Surface o = surface_in(top, *top.objects[inst.object], r, h, mirrored != flip);
+        Surface w;
+        w.point = ray.org + ray.dir * hit.t;
+        w.material = o.material;
+        w.geometric_normal = normalize(inst.to_object.transposed_vector(o.geometric_normal));
+        w.shading_normal = normalize(inst.to_object.transposed_vector(o.shading_normal));
+        return w;
+    }
     Surface s;
     s.point = ray.org + ray.dir * hit.t;
     s.material = scene.prim_material[hit.prim];
@@ -34,10 +56,11 @@ Surface surface_at(const Scene& scene, const Rayf& ray, const Hitf& hit) {
             break;
         case PrimKind::Triangle: {
             const TriangleSoA& t = scene.triangles;
-            s.geometric_normal = triangle_normal(t, i);
+            s.geometric_normal = mirrored ? -triangle_normal(t, i) : triangle_normal(t, i);
             s.shading_normal = t.has_normals[i] ? smooth_normal(t, i, hit, s.geometric_normal) : s.geometric_normal;
             break;
         }
+        case PrimKind::Instance: break;  // never a hit id: hits inside carry their own
         case PrimKind::HeightField:
             s.geometric_normal = normalize(height_field_normal(scene.height_fields[i], hit.u, hit.v));
             s.shading_normal = s.geometric_normal;
@@ -49,6 +72,12 @@ Surface surface_at(const Scene& scene, const Rayf& ray, const Hitf& hit) {
             break;
     }
     return s;
+}
+
+}  // namespace
+
+Surface surface_at(const Scene& scene, const Rayf& ray, const Hitf& hit) {
+    return surface_in(scene, scene, ray, hit, false);
 }
 
 

@@ -45,6 +45,7 @@ private:
 };
 
 inline Surface SurfaceTable::at(const Rayf& ray, const Hitf& hit) const {
+    if (hit.prim >= records_.size()) return surface_at(scene_, ray, hit);  // inside an instance
     const Record r = records_[hit.prim];
     Surface s;
     s.point = ray.org + ray.dir * hit.t;

@@ -4,8 +4,11 @@
 
 namespace raypack {
 
-Scene height_fields_as_triangles(const Scene& scene) {
-    if (scene.height_fields.empty()) return scene;
+namespace {
+
+/// `scene` with its fields as triangles, and `objects` as its objects (the
+/// converted ones for the top scene; none for an object).
+Scene convert(const Scene& scene, const std::vector<std::shared_ptr<const Scene>>& objects) {
     std::size_t triangles = scene.triangles.size();
     for (const HeightField& f : scene.height_fields) triangles += 2 * std::size_t(f.cells_x()) * f.cells_y();
     require_memory(std::uint64_t(triangles) * 80, scene.source + ": height fields as " +
@@ -15,6 +18,8 @@ Scene height_fields_as_triangles(const Scene& scene) {
     out.triangles = {};
     out.cones = {};
     out.height_fields = {};
+    out.instances = {};
+    out.objects = objects;
     out.prims.clear();
     out.prim_material.clear();
     out.reserve_triangles(triangles);
@@ -43,6 +48,11 @@ Scene height_fields_as_triangles(const Scene& scene) {
                 out.add_cone(c.base[i], sign * c.base_radius[i], c.apex[i], sign * c.apex_radius[i], m);
                 break;
             }
+            case PrimKind::Instance:
+                out.instances.push_back(scene.instances[i]);
+                out.prims.push_back({PrimKind::Instance, std::uint32_t(out.instances.size() - 1)});
+                out.prim_material.push_back(m);
+                break;
             case PrimKind::HeightField: {
                 const HeightField& f = scene.height_fields[i];
                 auto point = [&](std::uint32_t a, std::uint32_t b) {
@@ -61,6 +71,25 @@ Scene height_fields_as_triangles(const Scene& scene) {
         }
     }
     for (AreaLight& l : out.area_lights) l.first_prim = renumber[l.first_prim];
+    return out;
+}
+
+}  // namespace
+
+Scene height_fields_as_triangles(const Scene& scene) {
+    bool any = !scene.height_fields.empty();
+    for (const auto& o : scene.objects) any |= o->features.height_fields;
+    if (!any) return scene;
+    // Objects first (their fields too), in order: an object's instances
+    // count the ids of the converted objects before it.
+    Scene top_view;  // what the objects' numbering reads: the converted objects and the materials
+    top_view.materials = scene.materials;
+    for (const auto& o : scene.objects) {
+        auto converted = std::make_shared<Scene>(convert(*o, {}));
+        converted->update_features(&top_view);
+        top_view.objects.push_back(std::move(converted));
+    }
+    Scene out = convert(scene, top_view.objects);
     out.update_features();
     return out;
 }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <iterator>
+#include <memory>
 #include <istream>
 #include <span>
 #include <string>
@@ -116,14 +117,23 @@ public:
             else if (kw == "lens") lens();
             else if (kw == "gloss") gloss();
             else if (kw == "hf") height_field();
+            else if (kw == "begin") begin_object();
+            else if (kw == "end") end_object();
+            else if (kw == "inst") instance();
             else if (float x; parse_float_token(kw, x) != NumberToken::NotNumber)
                 fail(entity_line_, "unexpected number " + quote_token(kw) +
                                        " where an entity keyword was expected (too many values before it?)");
             else
                 fail(entity_line_, "unknown keyword " + quote_token(kw));
         }
+        if (defining_)
+            fail(entity_line_, "object " + quote_token(defining_name_) + " begun on line " +
+                                   std::to_string(defining_line_) + " has no 'end'");
         scene_.has_camera = camera_line_ != 0;
         scene_.update_features();
+        if (scene_.hit_id_count() > kMaxHitIds - 1)
+            fail(tok_.line(), "the scene holds more than 2^32 - 2 primitives with its instances expanded; "
+                              "hits are numbered in 32 bits");
         return std::move(scene_);
     }
 
@@ -226,6 +236,7 @@ private:
     }
 
     void light() {
+        refuse_inside_object();
         PointLight l;
         l.position = vec3("light position");
         l.has_color = optional_color(l.color, false);
@@ -253,6 +264,7 @@ private:
     }
 
     void parallelogram_light() {
+        refuse_inside_object();
         AreaLight l;
         l.shape = AreaLightShape::Parallelogram;
         l.corner = vec3("light corner");
@@ -271,6 +283,7 @@ private:
     }
 
     void sphere_light() {
+        refuse_inside_object();
         AreaLight l;
         l.shape = AreaLightShape::Sphere;
         l.center = vec3("light centre");
@@ -283,6 +296,7 @@ private:
     }
 
     void distant_light() {
+        refuse_inside_object();
         DistantLight l;
         const Vec3f d = vec3("light direction");
         if (!(length(d) > 0)) fail(tok_.line(), "zero light direction" + where());
@@ -297,7 +311,7 @@ private:
         std::filesystem::path path(file);
         if (path.is_relative() && !name_.starts_with("gen:")) path = std::filesystem::path(name_).parent_path() / path;
         try {
-            append_obj_triangles(path.string(), material(), scene_);
+            append_obj_triangles(path.string(), material(), target());
         } catch (const SceneError& e) {
             fail(entity_line_, "obj " + quote_token(file) + ": " + e.what());
         }
@@ -346,7 +360,7 @@ private:
         }
         for (const float z : f.z)
             if (!std::isfinite(z)) fail(entity_line_, "height field height overflows" + where());
-        scene_.add_height_field(std::move(f), material());
+        target().add_height_field(std::move(f), material());
     }
 
     void read_height_image(const std::string& file, HeightField& f) {
@@ -372,6 +386,77 @@ private:
             for (std::uint32_t i = 0; i < w; ++i) f.z[std::size_t(j) * w + i] = pixels[std::size_t(h - 1 - j) * w + i];
         for (const float z : f.z)
             if (!std::isfinite(z)) fail(entity_line_, "hf " + quote_token(file) + ": non-finite pixel value");
+    }
+
+    /// Primitives go to the object being defined, else to the scene.
+    Scene& target() { return defining_ ? *defining_ : scene_; }
+
+    /// Lights are the scene's, not an object's: an instance would have to
+    /// place them, and light sampling knows only the scene's own.
+    void refuse_inside_object() {
+        if (defining_)
+            fail(entity_line_, "a light inside object " + quote_token(defining_name_) +
+                                   " (lights belong to the scene, outside 'begin' ... 'end')");
+    }
+
+    // `begin NAME` ... `end`: an object, placed only by `inst`.
+    void begin_object() {
+        const std::string_view name = expect_token("object name");
+        if (defining_)
+            fail(entity_line_, "'begin " + std::string(name) + "' inside object " + quote_token(defining_name_) +
+                                   " (begun on line " + std::to_string(defining_line_) + "): objects do not nest");
+        for (std::size_t k = 0; k < scene_.object_names.size(); ++k)
+            if (scene_.object_names[k] == name) fail(entity_line_, "object " + quote_token(name) + " defined twice");
+        defining_ = std::make_shared<Scene>();
+        defining_->source = name_;
+        defining_name_ = std::string(name);
+        defining_line_ = entity_line_;
+    }
+
+    void end_object() {
+        if (!defining_) fail(entity_line_, "'end' without 'begin'");
+        if (defining_->prims.empty()) fail(entity_line_, "object " + quote_token(defining_name_) + " is empty");
+        defining_->update_features(&scene_);
+        if (defining_->hit_id_count() > kMaxHitIds - 1)
+            fail(entity_line_, "object " + quote_token(defining_name_) + " holds " +
+                                   std::to_string(defining_->hit_id_count()) +
+                                   " primitives with its instances expanded; hits are numbered in 32 bits");
+        scene_.objects.push_back(std::move(defining_));
+        scene_.object_names.push_back(defining_name_);
+        defining_.reset();
+    }
+
+    // `inst NAME m00 m01 m02 m03 m10 .. m23`: places NAME by the 3 x 4
+    // row-major affine matrix.
+    void instance() {
+        const std::string_view name = expect_token("object name");
+        std::size_t k = 0;
+        while (k < scene_.object_names.size() && scene_.object_names[k] != name) ++k;
+        if (k == scene_.object_names.size()) {
+            if (defining_ && name == defining_name_)
+                fail(entity_line_, "object " + quote_token(name) + " places itself (instances cannot be recursive)");
+            fail(entity_line_, "unknown object " + quote_token(name) + " (define it with 'begin' ... 'end' first)");
+        }
+        if (scene_.objects[k]->instance_depth() + 1 > kMaxInstanceDepth)
+            fail(entity_line_, "placing " + quote_token(name) + " nests instances more than " +
+                                   std::to_string(kMaxInstanceDepth) + " levels deep");
+        Affine3f m;
+        for (auto& row : m.m)
+            for (float& x : row) x = number("instance matrix entry");
+        const double det = affine_cast<double>(m).determinant();
+        if (!std::isfinite(det) || std::fabs(det) < 1e-30)
+            fail(tok_.line(), "singular instance matrix (determinant " + std::to_string(det) + ")" + where());
+        const Affine3d inv = inverse(affine_cast<double>(m));
+        for (const auto& row : inv.m)
+            for (double x : row)
+                if (!std::isfinite(float(x))) fail(tok_.line(), "instance matrix has no finite inverse" + where());
+        target().add_instance(std::uint32_t(k), m, scene_);
+        if (!defining_) {
+            top_instanced_ids_ += scene_.objects[k]->hit_id_count();
+            if (scene_.prims.size() + top_instanced_ids_ > kMaxHitIds - 1)
+                fail(entity_line_, "the scene holds more than 2^32 - 2 primitives with its instances expanded; "
+                                   "hits are numbered in 32 bits");
+        }
     }
 
     void lens() {
@@ -406,7 +491,7 @@ private:
     void sphere() {
         const Vec3f c = vec3("sphere centre");
         const float r = number("sphere radius");
-        scene_.add_sphere(c, r, material());
+        target().add_sphere(c, r, material());
     }
 
     void cone() {
@@ -418,7 +503,7 @@ private:
         // Negative radii mean "inside only", which needs both to agree.
         if ((base_r < 0 && apex_r > 0) || (base_r > 0 && apex_r < 0))
             fail(tok_.line(), "cone radii of opposite signs" + where());
-        scene_.add_cone(base, base_r, apex, apex_r, material());
+        target().add_cone(base, base_r, apex, apex_r, material());
     }
 
     // A polygon of n vertices becomes n-2 triangles (triangulate_polygon). A
@@ -444,10 +529,10 @@ private:
         const std::uint32_t m = material();
         for (const auto& t : triangulate_polygon(std::span<const Vec3f>(verts_))) {
             if (patch)
-                scene_.add_triangle(verts_[t[0]], verts_[t[1]], verts_[t[2]], normals_[t[0]], normals_[t[1]],
+                target().add_triangle(verts_[t[0]], verts_[t[1]], verts_[t[2]], normals_[t[0]], normals_[t[1]],
                                     normals_[t[2]], m);
             else
-                scene_.add_triangle(verts_[t[0]], verts_[t[1]], verts_[t[2]], m);
+                target().add_triangle(verts_[t[0]], verts_[t[1]], verts_[t[2]], m);
         }
     }
 
@@ -462,6 +547,10 @@ private:
     /// The last "f" (lights' own surfaces get copies of it appended after it), -1 before any.
     std::int32_t current_material_ = -1;
     std::vector<Vec3f> verts_, normals_;  ///< reused between polygons
+    std::shared_ptr<Scene> defining_;     ///< the object between 'begin' and 'end', if any
+    std::string defining_name_;
+    int defining_line_ = 0;
+    std::uint64_t top_instanced_ids_ = 0;  ///< hit ids of the scene's instances so far
 };
 
 }  // namespace

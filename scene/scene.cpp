@@ -68,7 +68,21 @@ std::uint32_t Scene::add_height_field(HeightField field, std::uint32_t material)
     return std::uint32_t(prims.size() - 1);
 }
 
-void Scene::update_features() {
+std::uint32_t Scene::add_instance(std::uint32_t object, const Affine3f& to_world, const Scene& top) {
+    Instance inst;
+    inst.object = object;
+    inst.to_world = to_world;
+    inst.to_object = affine_cast<float>(inverse(affine_cast<double>(to_world)));
+    inst.bounds = transform_box(to_world, scene_bounds(*top.objects[object]));
+    instances.push_back(inst);
+    prims.push_back({PrimKind::Instance, std::uint32_t(instances.size() - 1)});
+    prim_material.push_back(0);  // never read: hits name the primitives inside
+    return std::uint32_t(prims.size() - 1);
+}
+
+void Scene::update_features(const Scene* top) {
+    if (top == nullptr) top = this;
+    const auto& top_materials = top->materials;
     Features f;
     f.spheres = spheres.size() > 0;
     f.triangles = triangles.size() > 0;
@@ -77,17 +91,37 @@ void Scene::update_features() {
     for (auto h : triangles.has_normals) f.vertex_normals |= h != 0;
     for (auto h : spheres.inside_only) f.inside_only |= h != 0;
     for (auto h : cones.inside_only) f.inside_only |= h != 0;
-    for (std::uint32_t m : prim_material) {
-        f.reflection |= materials[m].ks > 0;
-        f.transmission |= materials[m].transmittance > 0;
+    for (std::size_t p = 0; p < prims.size(); ++p) {
+        if (prims[p].kind == PrimKind::Instance) continue;
+        const std::uint32_t m = prim_material[p];
+        f.reflection |= top_materials[m].ks > 0;
+        f.transmission |= top_materials[m].transmittance > 0;
+        f.glossy |= top_materials[m].gloss > 0;
     }
-    for (std::uint32_t m : prim_material) f.glossy |= materials[m].gloss > 0;
     for (const auto& l : lights) f.colored_lights |= l.has_color;
     for (const auto& l : area_lights) f.colored_lights |= l.has_color;
     for (const auto& l : distant_lights) f.colored_lights |= l.has_color;
     f.area_lights = !area_lights.empty();
     f.distant_lights = !distant_lights.empty();
     f.thin_lens = camera.lens_radius > 0;
+    f.instances = !instances.empty();
+    // Ids of instanced hits follow the scene's own primitives, instance by
+    // instance (Scene::hit_id_count); objects report what they contain.
+    hit_ids_ = prims.size();
+    instanced_prims_ = prims.size() - instances.size();
+    instance_depth_ = 0;
+    for (Instance& inst : instances) {
+        const Scene& o = *top->objects[inst.object];
+        inst.first_hit_id = std::uint32_t(std::min<std::uint64_t>(hit_ids_, kMaxHitIds));
+        hit_ids_ += o.hit_id_count();
+        instanced_prims_ += o.instanced_primitive_count();
+        instance_depth_ = std::max(instance_depth_, 1 + o.instance_depth());
+        const Features& g = o.features;
+        f.spheres |= g.spheres, f.triangles |= g.triangles, f.cones |= g.cones;
+        f.height_fields |= g.height_fields, f.instances |= g.instances;
+        f.vertex_normals |= g.vertex_normals, f.inside_only |= g.inside_only;
+        f.reflection |= g.reflection, f.transmission |= g.transmission, f.glossy |= g.glossy;
+    }
     features = f;
 }
 
@@ -117,6 +151,7 @@ Box3f primitive_bounds(const Scene& s, std::uint32_t prim) {
             b.extend(s.triangles.p1[i]);
             b.extend(s.triangles.p2[i]);
             break;
+        case PrimKind::Instance: b = s.instances[i].bounds; break;
         case PrimKind::HeightField:
             b.extend(s.height_fields[i].lo);
             b.extend(s.height_fields[i].hi);
@@ -143,6 +178,29 @@ Box3f scene_bounds(const Scene& s) {
     Box3f b;
     for (std::uint32_t i = 0; i < s.prims.size(); ++i) b.extend(primitive_bounds(s, i));
     return b;
+}
+
+const Instance& instance_of_hit_id(const Scene& scene, std::uint32_t id) {
+    // The last instance whose ids start at or before id.
+    const auto it = std::upper_bound(scene.instances.begin(), scene.instances.end(), id,
+                                     [](std::uint32_t x, const Instance& k) { return x < k.first_hit_id; });
+    return *(it - 1);
+}
+
+ResolvedHit resolve_hit_id(const Scene& top, std::uint32_t id) {
+    ResolvedHit r;
+    const Scene* s = &top;
+    while (id >= s->prims.size() && !s->instances.empty()) {
+        const Instance& inst = instance_of_hit_id(*s, id);
+        id -= inst.first_hit_id;
+        r.to_world = r.instanced ? compose(r.to_world, inst.to_world) : inst.to_world;
+        r.to_object = r.instanced ? compose(inst.to_object, r.to_object) : inst.to_object;
+        r.instanced = true;
+        s = top.objects[inst.object].get();
+    }
+    r.scene = s;
+    r.prim = id;
+    return r;
 }
 
 }  // namespace raypack

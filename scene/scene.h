@@ -2,15 +2,17 @@
 // The scene as structure of arrays: one set of arrays per primitive kind,
 // plus a global numbering of primitives in the order the file defines them.
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "kernels/aabb.h"
+#include "kernels/affine.h"
 #include "kernels/height_field.h"
 
 namespace raypack {
 
-enum class PrimKind : std::uint8_t { Sphere, Triangle, Cone, HeightField };
+enum class PrimKind : std::uint8_t { Sphere, Triangle, Cone, HeightField, Instance };
 
 /// Scene-global primitive number -> kind and index into that kind's arrays.
 struct PrimRef {
@@ -107,12 +109,24 @@ struct ConeSoA {
     std::size_t size() const { return base.size(); }
 };
 
+/// NFF extension `inst NAME m00 .. m23`: object `object` (an index into the
+/// top scene's Scene::objects) placed by `to_world`. Hits inside it are
+/// numbered from `first_hit_id` on in the id space of the scene that holds
+/// the instance (see Scene::hit_id_count).
+struct Instance {
+    std::uint32_t object = 0;
+    Affine3f to_world, to_object;  ///< to_object is the inverse of to_world
+    Box3f bounds;                  ///< world bounds of the placed object
+    std::uint32_t first_hit_id = 0;
+};
+
 /// What a scene uses, so that the hot loops can skip what it does not.
 struct Features {
     bool spheres = false;
     bool triangles = false;
     bool cones = false;
     bool height_fields = false;
+    bool instances = false;
     bool vertex_normals = false;
     bool reflection = false;    ///< some material has Ks > 0
     bool transmission = false;  ///< some material has T > 0
@@ -139,6 +153,14 @@ struct Scene {
     ConeSoA cones;
     /// NFF extension `hf`: each field is one primitive (kernels/height_field.h).
     std::vector<HeightField> height_fields;
+    /// NFF extension `inst`: each placement is one primitive.
+    std::vector<Instance> instances;
+    /// NFF extension `begin NAME` ... `end`: the objects that instances place,
+    /// in definition order (an object only places objects defined before it,
+    /// so there are no cycles). Only the top scene holds them; an object's own
+    /// instances index the top scene's list. Materials are the top scene's.
+    std::vector<std::shared_ptr<const Scene>> objects;
+    std::vector<std::string> object_names;
 
     std::vector<PrimRef> prims;                ///< global number -> kind, index
     std::vector<std::uint32_t> prim_material;  ///< global number -> materials[]
@@ -146,6 +168,18 @@ struct Scene {
     Features features;
 
     std::size_t primitive_count() const { return prims.size(); }
+    /// Hit ids (Hit::prim) run over [0, hit_id_count()): the scene's own
+    /// primitives keep their numbers (an instance's own number is never a
+    /// hit), and instance k's hits are first_hit_id + the id inside its
+    /// object, which past the object's own primitives recurses the same way.
+    /// Without instances it is primitive_count().
+    std::uint64_t hit_id_count() const { return instances.empty() ? prims.size() : hit_ids_; }
+    /// Primitives once every instance is expanded (instances themselves not
+    /// counted): what the scene would hold flattened.
+    std::uint64_t instanced_primitive_count() const { return instances.empty() ? prims.size() : instanced_prims_; }
+    /// Levels of placements below this scene: 0 without instances, else 1 +
+    /// the deepest placed object's.
+    int instance_depth() const { return instances.empty() ? 0 : instance_depth_; }
     /// Lights of every kind: the L of the SPD intensity rule.
     std::size_t light_count() const { return lights.size() + area_lights.size() + distant_lights.size(); }
     /// SPD Readme: each light (and the ambient term) gets sqrt(L) / (2 L).
@@ -160,14 +194,47 @@ struct Scene {
                            std::uint32_t material);
     /// Takes the samples; builds the field's min/max pyramid.
     std::uint32_t add_height_field(HeightField field, std::uint32_t material);
+    /// Places objects[object] under `to_world`, which must be finite and
+    /// invertible (the loader checks); `top` holds the objects (it may be
+    /// this scene). Call update_features before tracing: it numbers the hit ids.
+    std::uint32_t add_instance(std::uint32_t object, const Affine3f& to_world, const Scene& top);
     /// Room for `more` triangles, so that a loader that knows how many
     /// follow does not grow the arrays by copying (fresh pages cost more
     /// than the copies on the measured machines).
     void reserve_triangles(std::size_t more);
 
-    /// Recomputes `features` from the contents; loaders call it last.
-    void update_features();
+    /// Recomputes `features` and the hit id numbering from the contents;
+    /// loaders call it last (and on each object when its definition ends).
+    /// `top` is the scene whose objects and materials this one uses (null:
+    /// this scene itself).
+    void update_features(const Scene* top = nullptr);
+
+private:
+    std::uint64_t hit_ids_ = 0, instanced_prims_ = 0;
+    int instance_depth_ = 0;
 };
+
+/// Deepest nesting of placements a scene may have: each level is a nested
+/// traversal on the stack (and a transform of every ray that reaches it).
+inline constexpr int kMaxInstanceDepth = 32;
+
+/// Hit ids past this are not representable (kNoPrim is the miss).
+inline constexpr std::uint64_t kMaxHitIds = 0xFFFFFFFFull;
+
+/// A hit id resolved to the primitive it names: `scene` holds it (the top
+/// scene or an object), `prim` is its number there, and `to_world` carries
+/// that scene's space to the top scene's (the composition of the instances
+/// on the way; the identity for the top scene's own primitives).
+struct ResolvedHit {
+    const Scene* scene = nullptr;
+    std::uint32_t prim = 0;
+    Affine3f to_world, to_object;
+    bool instanced = false;
+};
+ResolvedHit resolve_hit_id(const Scene& top, std::uint32_t id);
+
+/// The instance of `scene` whose hit ids hold `id` (id >= prims.size()).
+const Instance& instance_of_hit_id(const Scene& scene, std::uint32_t id);
 
 /// Bounds of one primitive and of the whole scene.
 Box3f primitive_bounds(const Scene& scene, std::uint32_t prim);

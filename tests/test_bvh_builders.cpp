@@ -106,6 +106,7 @@ std::vector<Rayf> test_rays(const Scene& scene, const Bvh2& bvh) {
             }
             case PrimKind::Cone: return scene.cones.apex[ref.index];
             case PrimKind::HeightField: return scene.height_fields[ref.index].peak();
+            case PrimKind::Instance: break;  // no instances here
         }
         return box.center();
     };

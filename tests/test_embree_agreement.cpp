@@ -71,6 +71,7 @@ const char* kind_name(const Scene& s, std::uint32_t prim) {
         case PrimKind::Triangle: return "triangle";
         case PrimKind::Cone: return "cone";
         case PrimKind::HeightField: return "height field";
+        case PrimKind::Instance: return "instance";
     }
     return "?";
 }
@@ -319,6 +320,7 @@ Scene single(PrimKind kind) {
         case PrimKind::Triangle: s.add_triangle({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, 0); break;
         case PrimKind::Cone: s.add_cone({0, 0, 0}, 1, {0, 0, 2}, 1, 0); break;
         case PrimKind::HeightField: ADD_FAILURE() << "the Embree backend has no height fields"; break;
+        case PrimKind::Instance: ADD_FAILURE() << "the Embree backend has no instances"; break;
     }
     s.update_features();
     return s;

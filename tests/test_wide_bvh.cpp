@@ -86,6 +86,7 @@ Vec3f extreme_point(const Scene& s, std::uint32_t p, std::mt19937& rng) {
         }
         case PrimKind::Cone: return rng() % 2 ? s.cones.base[i] : s.cones.apex[i];
         case PrimKind::HeightField: return s.height_fields[i].peak();
+        case PrimKind::Instance: return s.instances[i].bounds.center();
     }
     return {};
 }

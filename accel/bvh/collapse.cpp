@@ -349,7 +349,7 @@ private:
                 const std::span<const std::uint32_t> chunk(prims.data() + j, std::min<std::size_t>(M, prims.size() - j));
                 const std::uint32_t b = c.blocks[k]++;
                 PrimKinds::dispatch(PrimKind(k), [&]<class Kind>() {
-                    Kind::template pack<M>(out_.template blocks<Kind>()[b], chunk, scene_, BlockLayout{config_.triangle_layout});
+                    Kind::template pack<M>(out_.template blocks<Kind>()[b], chunk, scene_, BlockLayout{config_.triangle_layout, config_.objects});
                 });
                 ++runs.count[k];
             }

@@ -28,6 +28,7 @@ struct CollapseConfig {
     float block_cost = 1.0f;
     int max_leaf_prims = 8;  ///< subtrees with more primitives stay inner nodes
     TriangleLayout triangle_layout = TriangleLayout::Edges;
+    const ObjectAccels* objects = nullptr;  ///< what instance blocks point to
 };
 
 template <int N, int M>

@@ -36,6 +36,7 @@ WideBvhAccel<N, M, Test>::WideBvhAccel(const Scene& scene, const AccelConfig& co
     const Bvh2 binary = build_scene_bvh2(scene, config);
     CollapseConfig cc = collapse;
     cc.triangle_layout = collapse_config(config).triangle_layout;  // must match the kernel that runs
+    cc.objects = config.kernels.objects;
     bvh_ = collapse_bvh<N, M>(binary, scene, cc);
     const auto stop = std::chrono::steady_clock::now();
     stats_.name = N == 4 ? "bvh4" : "bvh8";

@@ -154,7 +154,10 @@ RAYPACK_INLINE void packet_run(const Block* b, std::uint32_t count, SphereMethod
     for (; count != 0; --count, ++b) {
         for (int j = 0; j < M && b->prim[j] != kNoPrim; ++j) {
             F t(0.0f), u(0.0f), v(0.0f);  // the kernels set only their hit lanes
-            vmask<K> m = Kind::template intersect_slot<TM, F, M>(*b, j, sm, r, active, s.tfar, t, u, v);
+            [[maybe_unused]] std::uint32_t ids[names_hits<Kind> ? K : 1];
+            vmask<K> m;
+            if constexpr (names_hits<Kind>) m = Kind::template intersect_slot<TM, F, M>(*b, j, sm, r, active, s.tfar, t, u, v, ids);
+            else m = Kind::template intersect_slot<TM, F, M>(*b, j, sm, r, active, s.tfar, t, u, v);
             if (none(m)) continue;
             if constexpr (AnyHit) {
                 s.occluded = s.occluded | m;
@@ -167,8 +170,11 @@ RAYPACK_INLINE void packet_run(const Block* b, std::uint32_t count, SphereMethod
                 s.hit.u = select(m, u, s.hit.u);
                 s.hit.v = select(m, v, s.hit.v);
                 s.tfar = select(m, t, s.tfar);
-                for (std::uint32_t bits = mask_bits(m); bits != 0; bits &= bits - 1)
-                    s.hit.prim[std::countr_zero(bits)] = b->prim[j];
+                for (std::uint32_t bits = mask_bits(m); bits != 0; bits &= bits - 1) {
+                    const int l = std::countr_zero(bits);
+                    if constexpr (names_hits<Kind>) s.hit.prim[l] = ids[l];
+                    else s.hit.prim[l] = b->prim[j];
+                }
             }
         }
     }

@@ -51,11 +51,22 @@ RAYPACK_INLINE bool intersect_run(const typename Kind::template Block<M>* b, std
     for (; n != 0; --n, ++b) {
         count.block(b->prim);
         F t(0.0f), u(0.0f), v(0.0f);  // set by the kernel on hit lanes only
-        const std::uint32_t bits = mask_bits(Kind::template intersect_block<TM, F, M>(*b, sm, r, F(tfar), t, u, v));
-        if (bits == 0) continue;
-        if constexpr (AnyHit) return true;
-        found = true;
-        record_nearest(bits, t, u, v, b->prim, tfar, hit);
+        if constexpr (names_hits<Kind>) {
+            alignas(64) std::uint32_t ids[M];
+            const std::uint32_t bits =
+                mask_bits(Kind::template intersect_block<TM, F, M>(*b, sm, r, F(tfar), t, u, v, ids));
+            if (bits == 0) continue;
+            if constexpr (AnyHit) return true;
+            found = true;
+            record_nearest(bits, t, u, v, ids, tfar, hit);
+        } else {
+            const std::uint32_t bits =
+                mask_bits(Kind::template intersect_block<TM, F, M>(*b, sm, r, F(tfar), t, u, v));
+            if (bits == 0) continue;
+            if constexpr (AnyHit) return true;
+            found = true;
+            record_nearest(bits, t, u, v, b->prim, tfar, hit);
+        }
     }
     return found;
 }

@@ -286,6 +286,8 @@ void EmbreeAccel::build(const Scene& scene, const EmbreeOptions& options) {
     if ((scene.spheres.size() && !rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_POINT_GEOMETRY_SUPPORTED)) ||
         (scene.cones.size() && !rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_USER_GEOMETRY_SUPPORTED)))
         fail("this build lacks point or user geometry");
+    if (!scene.instances.empty())
+        fail("the scene has instances, which the Embree backend does not trace (raypack's own structures do)");
     if (!scene.height_fields.empty())
         fail("the scene has height fields, which the Embree backend does not trace (raypack's own structures do)");
 
@@ -305,7 +307,8 @@ void EmbreeAccel::build(const Scene& scene, const EmbreeOptions& options) {
             case PrimKind::Sphere: sphere_global[ref.index] = g; break;
             case PrimKind::Triangle: tri_global[ref.index] = g; break;
             case PrimKind::Cone: cone_global[ref.index] = g; break;
-            case PrimKind::HeightField: break;  // refused above
+            case PrimKind::HeightField:
+            case PrimKind::Instance: break;  // refused above
         }
     }
     auto attach = [&](RTCGeometry geom, std::vector<std::uint32_t>&& globals) {

@@ -39,6 +39,7 @@ struct PrimitiveBoxOverlap {
             }
             case PrimKind::Cone:
             case PrimKind::HeightField:
+            case PrimKind::Instance:
                 return true;  // the caller has already intersected the bounding boxes
         }
         return true;

@@ -19,9 +19,13 @@ namespace raypack {
 /// precomputed exactly as the kernel computes them), Vertices for the others.
 enum class TriangleLayout : std::uint8_t { Edges, Vertices };
 
-/// Build-time choices of the block layouts.
+struct ObjectAccels;
+
+/// Build-time choices of the block layouts, and the structures instance
+/// blocks point to.
 struct BlockLayout {
     TriangleLayout triangles = TriangleLayout::Edges;
+    const ObjectAccels* objects = nullptr;
 };
 
 template <class F>

@@ -10,6 +10,8 @@
 //   intersect_slot<TM>(block, j, sphere, leaf_ray, active, tfar, t, u, v)  K x 1
 //   intersect(scene, index, kernels, ray, t, u, v)         by id, one ray
 //   intersect(scene, index, kernels, valid, lanes, t, u, v)  by id, lanes
+// and a kind whose hits are named inside it (instances: kNamesHits) takes
+// one more argument to each test, the ids of its hits.
 // Adding a kind: its file, a PrimKind value, and one entry below.
 #include <cstdint>
 #include <tuple>
@@ -17,6 +19,7 @@
 
 #include "accel/prims/cone_prims.h"
 #include "accel/prims/height_field_prims.h"
+#include "accel/prims/instance_prims.h"
 #include "accel/prims/sphere_prims.h"
 #include "accel/prims/triangle_prims.h"
 
@@ -58,7 +61,7 @@ struct KindList {
 };
 
 /// The kinds in the order a mixed leaf tests its runs.
-using PrimKinds = KindList<TrianglePrims, SpherePrims, ConePrims, HeightFieldPrims>;
+using PrimKinds = KindList<TrianglePrims, SpherePrims, ConePrims, HeightFieldPrims, InstancePrims>;
 inline constexpr int kPrimKinds = PrimKinds::size;
 
 }  // namespace raypack

@@ -8,6 +8,11 @@ namespace raypack::spd {
 
 std::string generate_balls(int size);
 std::string generate_tetra(int size);
+/// tetra of the same depth, its self-similarity written as instances: an
+/// object of depth min(size, 6) in triangles, and for every three further
+/// levels an object of 64 placements of the one below (not SPD;
+/// docs/instancing.md).
+std::string generate_tetra_instanced(int size);
 std::string generate_mount(int size);
 std::string generate_rings(int size);
 std::string generate_tree(int size);

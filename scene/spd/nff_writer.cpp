@@ -81,6 +81,19 @@ void NffWriter::viewpoint(const Vec3& from, const Vec3& at, const Vec3& up, doub
     text_ += "\nresolution " + std::to_string(res_x) + ' ' + std::to_string(res_y) + '\n';
 }
 
+void NffWriter::begin_object(const std::string& name) { text_ += "begin " + name + '\n'; }
+
+void NffWriter::end_object() { text_ += "end\n"; }
+
+void NffWriter::instance(const std::string& name, const std::array<double, 12>& matrix) {
+    text_ += "inst " + name;
+    for (const double m : matrix) {
+        text_ += ' ';
+        number(m);
+    }
+    text_ += '\n';
+}
+
 void NffWriter::light(const Vec3& position) {
     text_ += "l ";
     vec(position);

@@ -37,6 +37,12 @@ public:
     /// row of nx a line (not SPD: docs/scene-format.md).
     void height_field(int nx, int ny, const Vec3& lo, const Vec3& hi, std::span<const double> heights);
 
+    /// raypack's `begin NAME` ... `end` and `inst NAME m00 .. m23` (a 3 x 4
+    /// row-major matrix; not SPD: docs/scene-format.md).
+    void begin_object(const std::string& name);
+    void end_object();
+    void instance(const std::string& name, const std::array<double, 12>& matrix);
+
     const std::string& text() const { return text_; }
     std::string take() { return std::move(text_); }
 

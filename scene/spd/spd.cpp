@@ -17,7 +17,7 @@ struct Entry {
     int default_size;
     int limit;  ///< the generator's own largest size (its arithmetic), or 0
     std::string (*generate)(int size);
-    double (*primitives)(int size);  ///< primitives as loaded (polygons as triangles)
+    double (*primitives)(int size);  ///< primitives as loaded (polygons as triangles; with the objects')
     /// Bytes budgeted for loading and tracing it; nullptr: kSpdBytesPerPrimitive a primitive.
     double (*bytes)(int size) = nullptr;
 };
@@ -35,6 +35,14 @@ double power(double base, int exponent) {
 constexpr Entry kGenerators[] = {
     {"balls", 4, 0, spd::generate_balls, [](int n) { return (power(9, n + 1) - 1.0) / 8.0 + 2.0; }},
     {"tetra", 6, 0, spd::generate_tetra, [](int n) { return power(4, n); }},
+    // Stored: one object of 4^min(n, 6) triangles and at most 64
+    // placements for each further 3 levels; 15 is the deepest whose 4^n
+    // instanced triangles have 32-bit hit ids.
+    {"tetra-instanced", 6, 15, spd::generate_tetra_instanced, [](int n) {
+         if (n <= 6) return power(4, n) + 1.0;  // the object, placed once
+         const int groups = (n - 7) / 3;        // objects of 64 placements
+         return power(4, 6) + 64.0 * groups + power(4, n - 6 - 3 * groups);
+     }},
     {"mount", 6, 15, spd::generate_mount, [](int n) { return 2.0 * power(4, n) + 4.0; }},
     {"rings", 7, 0, spd::generate_rings, [](int n) { return 10.0 * n * (n + 1.0) * (2.0 * n + 1.0) + 2.0; }},
     {"tree", 11, 0, spd::generate_tree, [](int n) { return 2.0 * (power(2, n + 1) - 1.0) + 2.0; }},
