@@ -28,6 +28,9 @@ struct AccelStats {
     double refs_per_prim = 1;       ///< primitive references per primitive (> 1 where split or duplicated)
     std::size_t empty_leaves = 0;   ///< empty leaves, or empty cells for the grid
     std::size_t primitives = 0;     ///< primitives in the scene the structure was built over
+    /// The primitive kinds its hot loops were compiled for (bvh4, bvh8;
+    /// the other structures run the general loops).
+    KindSpecialisation specialisation = KindSpecialisation::General;
     double bytes_per_prim() const { return primitives ? double(bytes) / double(primitives) : 0.0; }
 };
 

@@ -23,6 +23,9 @@ struct KernelChoice {
     SlabMethod slabs = SlabMethod::Robust;
     RcpMethod rcp = RcpMethod::Exact;
     Precision precision = Precision::Float;
+    /// `--specialise`: whether the wide BVHs may run loops compiled for the
+    /// scene's primitive kinds alone (accel/prims/prim_kinds.h).
+    bool specialise = true;
     /// Not a choice but where the instance test finds the structures of the
     /// scene's objects (accel/prims/instance_prims.h): set by build_accel for
     /// a scene with instances, carried with the kernels because every leaf

@@ -29,6 +29,7 @@ constexpr Named<TriangleMethod> kTriangleNames[] = {
 constexpr Named<SlabMethod> kSlabNames[] = {{"robust", SlabMethod::Robust}, {"plain", SlabMethod::Plain}};
 constexpr Named<Precision> kPrecisionNames[] = {{"float", Precision::Float}, {"double", Precision::Double}};
 constexpr Named<RcpMethod> kRcpNames[] = {{"exact", RcpMethod::Exact}, {"approx", RcpMethod::Approx}};
+constexpr Named<bool> kSpecialiseNames[] = {{"on", true}, {"off", false}};
 
 /// The value `option` names, or its default (the first entry) without it.
 template <class E, std::size_t N>
@@ -78,7 +79,8 @@ std::string accel_options_help() {
 }
 
 std::vector<OptionSpec> kernel_option_specs() {
-    return {{"--sphere", "", 1}, {"--triangle", "", 1}, {"--slabs", "", 1}, {"--precision", "", 1}, {"--rcp", "", 1}};
+    return {{"--sphere", "", 1},    {"--triangle", "", 1}, {"--slabs", "", 1},
+            {"--precision", "", 1}, {"--rcp", "", 1},      {"--specialise", "", 1}};
 }
 
 KernelChoice kernel_choice_from(const ParsedArgs& args) {
@@ -88,6 +90,7 @@ KernelChoice kernel_choice_from(const ParsedArgs& args) {
     k.slabs = parse_named(args, "--slabs", kSlabNames);
     k.precision = parse_named(args, "--precision", kPrecisionNames);
     k.rcp = parse_named(args, "--rcp", kRcpNames);
+    k.specialise = parse_named(args, "--specialise", kSpecialiseNames);
     return k;
 }
 
@@ -96,7 +99,9 @@ std::string kernel_options_help() {
            "  --triangle moeller|watertight|plane     ray-triangle test (default moeller)\n"
            "  --slabs robust|plain          box test of the traversal (default robust: Ize 2013)\n"
            "  --rcp exact|approx            reciprocal directions: division, or rcp + one Newton step\n"
-           "  --precision float|double      arithmetic of the primitive tests (default float)\n";
+           "  --precision float|double      arithmetic of the primitive tests (default float)\n"
+           "  --specialise on|off           bvh4/bvh8 on a scene of triangles alone run loops compiled\n"
+           "                for triangles alone (default on); off: the general loops, for comparison\n";
 }
 
 AccelConfig accel_config_from(const ParsedArgs& args) {

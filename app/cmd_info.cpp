@@ -3,6 +3,7 @@
 
 #include "app/scene_options.h"
 #include "app/commands.h"
+#include "accel/prims/prim_kinds.h"
 #include "scene/load.h"
 
 namespace raypack::app {
@@ -73,25 +74,12 @@ int run_info(const Args& args) {
         std::printf("  distant along %g %g %g", l.direction.x, l.direction.y, l.direction.z);
         colour(l.has_color, l.color);
     }
-    const Features& f = scene.features;
     std::printf("features:");
-    const std::pair<bool, const char*> names[] = {{f.spheres, "spheres"},
-                                                  {f.triangles, "triangles"},
-                                                  {f.cones, "cones"},
-                                                  {f.height_fields, "height-fields"},
-                                                  {f.instances, "instances"},
-                                                  {f.vertex_normals, "vertex-normals"},
-                                                  {f.reflection, "reflection"},
-                                                  {f.transmission, "transmission"},
-                                                  {f.colored_lights, "coloured-lights"},
-                                                  {f.inside_only, "inside-only"},
-                                                  {f.area_lights, "area-lights"},
-                                                  {f.distant_lights, "distant-lights"},
-                                                  {f.glossy, "glossy"},
-                                                  {f.thin_lens, "thin-lens"}};
-    for (const auto& [on, name] : names)
-        if (on) std::printf(" %s", name);
+    for (const std::string& name : feature_names(scene.features)) std::printf(" %s", name.c_str());
     std::printf("\n");
+    // What build_accel would choose with the default kernels (accel/prims/prim_kinds.h).
+    std::printf("specialisation: %s (bvh4, bvh8 loops; the other structures run the general ones)\n",
+                specialisation_name(specialisation_for(scene, KernelChoice{})));
     return 0;
 }
 

@@ -101,6 +101,8 @@ int run_trace(const Args& args) {
         j["slabs"] = slab_method_name(config.kernels.slabs);
         j["rcp"] = rcp_method_name(config.kernels.rcp);
         j["precision"] = precision_name(config.kernels.precision);
+        j["features"] = feature_names(scene.features);
+        j["specialisation"] = specialisation_name(as.specialisation);
         j["default_config"] = fastest;  // chosen by the measured table, not the command line
         j["workload"] = workload_name(workload);
         j["kind"] = file.kind == RayKind::ClosestHit ? "closest" : "any";
@@ -126,7 +128,9 @@ int run_trace(const Args& args) {
         std::printf("raypack trace: %s, %zu %s rays, %s (%s) built in %.1f ms\n", scene.source.c_str(),
                     file.rays.size(), file.kind == RayKind::ClosestHit ? "closest-hit" : "any-hit", as.name.c_str(),
                     as.builder.c_str(), as.build_ms);
-        if (!is_embree_kind(as.name)) std::printf("  kernels: %s\n", kernel_choice_summary(config.kernels).c_str());
+        if (!is_embree_kind(as.name))
+            std::printf("  kernels: %s; loops for %s primitives\n", kernel_choice_summary(config.kernels).c_str(),
+                        specialisation_name(as.specialisation));
         std::printf("  packets of %d, %d threads, %d passes: median %.2f ms (min %.2f, max %.2f), %.2f Mrays/s; %zu %s\n",
                     packet, limit.threads(), repeat, median, sorted.front(), sorted.back(), mrays, hit_count,
                     file.kind == RayKind::ClosestHit ? "hits" : "occluded");

@@ -1,5 +1,7 @@
 #include "app/scene_options.h"
 
+#include <utility>
+
 #include "scene/flatten_instances.h"
 #include "scene/height_field_mesh.h"
 #include "scene/load.h"
@@ -26,6 +28,27 @@ std::string scene_option_help() {
            "                 2 (nx-1)(ny-1) triangles each, for comparison\n"
            "  --instances-as instances|flat  instances traced through their objects' structures\n"
            "                 (default), or every placement copied into the scene, for comparison\n";
+}
+
+std::vector<std::string> feature_names(const Features& f) {
+    const std::pair<bool, const char*> names[] = {{f.spheres, "spheres"},
+                                                  {f.triangles, "triangles"},
+                                                  {f.cones, "cones"},
+                                                  {f.height_fields, "height-fields"},
+                                                  {f.instances, "instances"},
+                                                  {f.vertex_normals, "vertex-normals"},
+                                                  {f.reflection, "reflection"},
+                                                  {f.transmission, "transmission"},
+                                                  {f.colored_lights, "coloured-lights"},
+                                                  {f.inside_only, "inside-only"},
+                                                  {f.area_lights, "area-lights"},
+                                                  {f.distant_lights, "distant-lights"},
+                                                  {f.glossy, "glossy"},
+                                                  {f.thin_lens, "thin-lens"}};
+    std::vector<std::string> out;
+    for (const auto& [on, name] : names)
+        if (on) out.emplace_back(name);
+    return out;
 }
 
 }  // namespace raypack::app

@@ -1,6 +1,7 @@
 #pragma once
 // --heightfield-as and --instances-as, shared by every command that loads a scene.
 #include <string>
+#include <vector>
 
 #include "app/commands.h"
 #include "scene/scene.h"
@@ -15,5 +16,7 @@ std::vector<OptionSpec> scene_option_specs();
 /// every placement's primitives copied into the scene).
 Scene load_scene_from(const ParsedArgs& args, const std::string& spec);
 std::string scene_option_help();
+/// The names of the features a scene uses ("spheres", "instances", ...).
+std::vector<std::string> feature_names(const Features& f);
 
 }  // namespace raypack::app

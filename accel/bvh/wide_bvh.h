@@ -119,18 +119,25 @@ struct WideBvh {
     /// leaf `code`, in PrimKinds order; fn returns whether it hit something,
     /// and with StopAtHit (any hit) the first hit ends the leaf. Whether any
     /// run hit. The one place a traversal learns a leaf's kinds.
-    template <bool StopAtHit, class Fn>
+    /// Kinds: the kinds the caller was compiled for (KindSpecialisation);
+    /// the tree must hold no other.
+    template <bool StopAtHit, class Kinds = PrimKinds, class Fn>
     RAYPACK_INLINE bool for_each_run(std::uint32_t code, Fn&& fn) const {
         const std::uint32_t first = wide_child::first(code), kind = wide_child::kind(code);
         if (kind != wide_child::kMixed) {
             const std::uint32_t count = wide_child::blocks(code);
-            return PrimKinds::dispatch(PrimKind(kind), [&]<class Kind>() RAYPACK_INLINE_LAMBDA {
+            if constexpr (Kinds::size == 1) {
+                using Kind = std::tuple_element_t<0, typename Kinds::Tuple>;
                 return fn.template operator()<Kind>(blocks<Kind>().data() + first, count);
-            });
+            } else {
+                return Kinds::dispatch(PrimKind(kind), [&]<class Kind>() RAYPACK_INLINE_LAMBDA {
+                    return fn.template operator()<Kind>(blocks<Kind>().data() + first, count);
+                });
+            }
         }
         const MixedLeaf& m = mixed[first];
         bool found = false;
-        PrimKinds::until([&]<class Kind>() RAYPACK_INLINE_LAMBDA {
+        Kinds::until([&]<class Kind>() RAYPACK_INLINE_LAMBDA {
             constexpr int k = int(Kind::kind);
             const bool hit = fn.template operator()<Kind>(blocks<Kind>().data() + m.first[k], m.count[k]);
             found |= hit;

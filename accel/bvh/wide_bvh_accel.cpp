@@ -48,6 +48,7 @@ WideBvhAccel<N, M, Test>::WideBvhAccel(const Scene& scene, const AccelConfig& co
     stats_.bytes = bvh_.bytes();
     stats_.sah_cost = sah_cost(bvh_, config.traversal_cost, config.intersection_cost);
     stats_.primitives = scene.primitive_count();
+    stats_.specialisation = specialisation_for(scene, config.kernels);
     if (stats_.primitives) stats_.refs_per_prim = double(binary.prim_index.size()) / double(stats_.primitives);
 }
 
@@ -57,17 +58,19 @@ void WideBvhAccel<N, M, Test>::trace(std::span<const Rayf> rays, Out&& out) cons
     // Variants chosen once per batch: the triangle kernel and precision by
     // template, slabs and rcp in each ray's setup (make_node_ray).
     const PrimitiveIntersector<float> isect{scene_, kernels_};
-    auto run = [&]<TriangleMethod TM, bool ByPrim>() {
+    auto run = [&]<TriangleMethod TM, bool ByPrim, class Kinds = PrimKinds>() {
         for (std::size_t i = 0; i < rays.size(); ++i) {
             Hitf hit;
-            const bool any = trace_wide<N, M, TM, Test, AnyHit, ByPrim>(bvh_, kernels_.sphere, rays[i], hit,
-                                                                        kernels_.slabs, kernels_.rcp, &isect);
+            const bool any = trace_wide<N, M, TM, Test, AnyHit, ByPrim, NoTraversalCounts, Kinds>(
+                bvh_, kernels_.sphere, rays[i], hit, kernels_.slabs, kernels_.rcp, &isect);
             out(i, any, hit);
         }
     };
     // Double: the block kernels are not used, so one instantiation serves
     // every triangle method (PrimitiveIntersector runs the chosen one).
     if (kernels_.precision == Precision::Double) return run.template operator()<TriangleMethod::Moeller, true>();
+    if (stats_.specialisation == KindSpecialisation::Triangles)
+        return run.template operator()<TriangleMethod::Moeller, false, TriangleKinds>();
     switch (kernels_.triangle) {
         case TriangleMethod::Moeller: return run.template operator()<TriangleMethod::Moeller, false>();
         case TriangleMethod::Watertight: return run.template operator()<TriangleMethod::Watertight, false>();

@@ -182,10 +182,10 @@ RAYPACK_INLINE void packet_run(const Block* b, std::uint32_t count, SphereMethod
 
 /// The blocks of one leaf against the active lanes (any hit: each run
 /// against the lanes not yet occluded).
-template <TriangleMethod TM, bool AnyHit, int N, int M, int K>
+template <TriangleMethod TM, bool AnyHit, class Kinds, int N, int M, int K>
 RAYPACK_INLINE void packet_leaf(const WideBvh<N, M>& bvh, SphereMethod sm, std::uint32_t code,
                                 const LeafRay<vfloat<K>>& r, const vmask<K>& active, PacketState<K>& s) {
-    bvh.template for_each_run<false>(code, [&]<class Kind>(const auto* blocks, std::uint32_t n) RAYPACK_INLINE_LAMBDA {
+    bvh.template for_each_run<false, Kinds>(code, [&]<class Kind>(const auto* blocks, std::uint32_t n) RAYPACK_INLINE_LAMBDA {
         packet_run<Kind, TM, AnyHit>(blocks, n, sm, r, AnyHit ? active & s.valid : active, s);
         return false;
     });
@@ -239,7 +239,7 @@ RAYPACK_INLINE vmask<K> mask_from_bits(std::uint32_t bits) {
 
 /// The lanes `bits` finish the subtree under `root` one ray at a time
 /// (Benthin et al. 2012), each from its own closest hit so far.
-template <int N, int M, int K, TriangleMethod TM, bool AnyHit, bool ByPrim>
+template <int N, int M, int K, TriangleMethod TM, bool AnyHit, bool ByPrim, class Kinds>
 void lanes_alone(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, std::uint32_t root, std::uint32_t bits,
                  const RayPacket<K>& ray, PacketState<K>& s) {
     using F = vfloat<K>;
@@ -270,7 +270,7 @@ void lanes_alone(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, std::uint
             lane_hit = trace_wide_subtree<N, M, TM, NodeTest::Ordered, AnyHit, true>(
                 bvh, pk.kernels.sphere, root, nr, LeafRay<vfloat<M>>{}, lane_tfar, h, &p);
         } else {
-            lane_hit = trace_wide_subtree<N, M, TM, NodeTest::Ordered, AnyHit>(
+            lane_hit = trace_wide_subtree<N, M, TM, NodeTest::Ordered, AnyHit, false, NoTraversalCounts, Kinds>(
                 bvh, pk.kernels.sphere, root, nr, make_leaf_ray<vfloat<M>>(r, TM), lane_tfar, h);
         }
         if (!lane_hit) continue;
@@ -299,8 +299,8 @@ void lanes_alone(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, std::uint
     }
 }
 
-/// One packet through the tree.
-template <int N, int M, int K, TriangleMethod TM, bool AnyHit, bool ByPrim>
+/// One packet through the tree, with leaves compiled for Kinds.
+template <int N, int M, int K, TriangleMethod TM, bool AnyHit, bool ByPrim, class Kinds>
 void trace_packet(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, int switch_below, const RayPacket<K>& ray,
                   HitPacket<K>& hit, vmask<K> valid, vmask<K>& occluded) {
     using F = vfloat<K>;
@@ -324,12 +324,12 @@ void trace_packet(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, int swit
         for (;;) {
             const std::uint32_t bits = mask_bits(active);
             if (std::popcount(bits) < switch_below) {
-                lanes_alone<N, M, K, TM, AnyHit, ByPrim>(bvh, pk, cur, bits, ray, s);
+                lanes_alone<N, M, K, TM, AnyHit, ByPrim, Kinds>(bvh, pk, cur, bits, ray, s);
                 break;
             }
             if (wide_child::is_leaf(cur)) {
                 if constexpr (ByPrim) packet_leaf_by_prim<AnyHit>(bvh, pk.packet, cur, ray, active, s);
-                else packet_leaf<TM, AnyHit>(bvh, sm, cur, lr, active, s);
+                else packet_leaf<TM, AnyHit, Kinds>(bvh, sm, cur, lr, active, s);
                 break;
             }
             const WideNode<N>& node = nodes[cur];
@@ -395,16 +395,18 @@ void wide_trace_packets(const WideBvh<N, M>& bvh, const Scene& scene, KernelChoi
         return;
     }
     const wide_packet_detail::PacketKernels<K> pk{kernels, {&scene, kernels}, {&scene, kernels}};
-    auto run = [&]<TriangleMethod TM, bool ByPrim>() {
+    auto run = [&]<TriangleMethod TM, bool ByPrim, class Kinds = PrimKinds>() {
         trace_in_packets<K, AnyHit>(rays, hits, kernels.rcp, [&](RayPacket<K>& ray, HitPacket<K>& hit,
                                                                  vmask<K> valid, vmask<K>& occluded) {
-            wide_packet_detail::trace_packet<N, M, K, TM, AnyHit, ByPrim>(bvh, pk, config.switch_below, ray, hit,
-                                                                          valid, occluded);
+            wide_packet_detail::trace_packet<N, M, K, TM, AnyHit, ByPrim, Kinds>(bvh, pk, config.switch_below, ray,
+                                                                                 hit, valid, occluded);
         });
     };
     // Double: leaves test primitives by id, so one instantiation serves every
     // triangle method (as in WideBvhAccel::trace).
     if (kernels.precision == Precision::Double) return run.template operator()<TriangleMethod::Moeller, true>();
+    if (specialisation_for(scene, kernels) == KindSpecialisation::Triangles)
+        return run.template operator()<TriangleMethod::Moeller, false, TriangleKinds>();
     switch (kernels.triangle) {
         case TriangleMethod::Moeller: return run.template operator()<TriangleMethod::Moeller, false>();
         case TriangleMethod::Watertight: return run.template operator()<TriangleMethod::Watertight, false>();

@@ -100,12 +100,12 @@ RAYPACK_INLINE bool intersect_run_by_prim(const Block* b, std::uint32_t n, const
 
 /// Tests the blocks of one leaf, through the block kernels or, ByPrim
 /// (--precision double), by id; true if something was hit.
-template <TriangleMethod TM, bool AnyHit, bool ByPrim, int N, int M, class Count>
+template <TriangleMethod TM, bool AnyHit, bool ByPrim, class Kinds, int N, int M, class Count>
 RAYPACK_INLINE bool intersect_leaf(const WideBvh<N, M>& bvh, SphereMethod sm, std::uint32_t code,
                                    const LeafRay<vfloat<M>>& r, const PrimLeafRay* by_prim, float& tfar, Hitf& hit,
                                    Count& count) {
     count.node();
-    return bvh.template for_each_run<AnyHit>(code, [&]<class Kind>(const auto* blocks, std::uint32_t n)
+    return bvh.template for_each_run<AnyHit, Kinds>(code, [&]<class Kind>(const auto* blocks, std::uint32_t n)
                                                         RAYPACK_INLINE_LAMBDA {
         if constexpr (ByPrim) return intersect_run_by_prim<AnyHit>(blocks, n, *by_prim, tfar, hit, count);
         else return intersect_run<Kind, TM, AnyHit, M>(blocks, n, sm, r, tfar, hit, count);
@@ -119,9 +119,10 @@ RAYPACK_INLINE bool intersect_leaf(const WideBvh<N, M>& bvh, SphereMethod sm, st
 /// True if it found a hit (any hit: returns at the first). ByPrim: leaves
 /// go through `by_prim` (--precision double), not the block kernels.
 /// `count` sees each node and leaf entered and each block tested
-/// (count_traversal); NoTraversalCounts compiles away.
+/// (count_traversal); NoTraversalCounts compiles away. Kinds: the kinds the
+/// loop is compiled for (KindSpecialisation).
 template <int N, int M, TriangleMethod TM, NodeTest Test, bool AnyHit, bool ByPrim = false,
-          class Count = NoTraversalCounts>
+          class Count = NoTraversalCounts, class Kinds = PrimKinds>
 RAYPACK_INLINE bool trace_wide_subtree(const WideBvh<N, M>& bvh, SphereMethod sphere_method, std::uint32_t root,
                                        const NodeRay<N>& nr, const LeafRay<vfloat<M>>& lr, float& tfar, Hitf& hit,
                                        const PrimLeafRay* by_prim = nullptr, Count count = {}) {
@@ -184,7 +185,7 @@ RAYPACK_INLINE bool trace_wide_subtree(const WideBvh<N, M>& bvh, SphereMethod sp
                 cur = (--sp)->node;
             }
         }
-        if (intersect_leaf<TM, AnyHit, ByPrim>(bvh, sphere_method, cur, lr, by_prim, tfar, hit, count)) {
+        if (intersect_leaf<TM, AnyHit, ByPrim, Kinds>(bvh, sphere_method, cur, lr, by_prim, tfar, hit, count)) {
             found = true;
             if constexpr (AnyHit) return true;
             tfar_v = F(node_tfar(tfar));
@@ -204,7 +205,7 @@ RAYPACK_INLINE bool trace_wide_subtree(const WideBvh<N, M>& bvh, SphereMethod sp
 /// ray in [tnear, tfar], with the node test variants `slabs`, `rcp` (see
 /// make_node_ray); ByPrim (--precision double) tests leaves through `isect`.
 template <int N, int M, TriangleMethod TM, NodeTest Test, bool AnyHit, bool ByPrim = false,
-          class Count = NoTraversalCounts>
+          class Count = NoTraversalCounts, class Kinds = PrimKinds>
 bool trace_wide(const WideBvh<N, M>& bvh, SphereMethod sphere_method, const Rayf& ray, Hitf& hit,
                 SlabMethod slabs = SlabMethod::Robust, RcpMethod rcp = RcpMethod::Exact,
                 const PrimitiveIntersector<float>* isect = nullptr, Count count = {}) {
@@ -213,10 +214,10 @@ bool trace_wide(const WideBvh<N, M>& bvh, SphereMethod sphere_method, const Rayf
     const NodeRay<N> nr = make_node_ray<Test, N>(ray, slabs, rcp);
     if constexpr (ByPrim) {
         const PrimLeafRay p{isect, ray};
-        return trace_wide_subtree<N, M, TM, Test, AnyHit, true>(bvh, sphere_method, 0, nr, LeafRay<vfloat<M>>{}, tfar,
-                                                                hit, &p, count);
+        return trace_wide_subtree<N, M, TM, Test, AnyHit, true, Count, Kinds>(bvh, sphere_method, 0, nr,
+                                                                              LeafRay<vfloat<M>>{}, tfar, hit, &p, count);
     } else {
-        return trace_wide_subtree<N, M, TM, Test, AnyHit, false>(
+        return trace_wide_subtree<N, M, TM, Test, AnyHit, false, Count, Kinds>(
             bvh, sphere_method, 0, nr, make_leaf_ray<vfloat<M>>(ray, TM), tfar, hit, nullptr, count);
     }
 }

@@ -17,6 +17,7 @@
 #include <tuple>
 #include <type_traits>
 
+#include "accel/kernel_choice.h"
 #include "accel/prims/cone_prims.h"
 #include "accel/prims/height_field_prims.h"
 #include "accel/prims/instance_prims.h"
@@ -33,6 +34,7 @@ namespace raypack {
 template <class... Kinds>
 struct KindList {
     static constexpr int size = sizeof...(Kinds);
+    using Tuple = std::tuple<Kinds...>;
 
     /// fn.template operator()<Kind>() for the kind whose PrimKind is k.
     template <class Fn>
@@ -63,5 +65,33 @@ struct KindList {
 /// The kinds in the order a mixed leaf tests its runs.
 using PrimKinds = KindList<TrianglePrims, SpherePrims, ConePrims, HeightFieldPrims, InstancePrims>;
 inline constexpr int kPrimKinds = PrimKinds::size;
+
+/// Which kinds a structure's hot loops are compiled for, chosen once per
+/// build from what the scene holds ("model only what the scene requires"):
+/// a scene of triangles alone runs loops with no sphere, cone, height-field
+/// or instance code in them; any other scene the general loops.
+enum class KindSpecialisation : std::uint8_t { General, Triangles };
+using TriangleKinds = KindList<TrianglePrims>;
+
+/// Triangles when the scene holds triangles and nothing else, for the
+/// default kernels (Moeller-Trumbore, float: the loops compiled twice) and
+/// unless `--specialise off`.
+inline KindSpecialisation specialisation_for(const Scene& scene, const KernelChoice& k) {
+    const bool triangles_only = scene.triangles.size() > 0 && scene.spheres.size() == 0 && scene.cones.size() == 0 &&
+                                scene.height_fields.empty() && scene.instances.empty();
+    const bool default_kernels = k.triangle == TriangleMethod::Moeller && k.precision == Precision::Float;
+    return k.specialise && triangles_only && default_kernels ? KindSpecialisation::Triangles
+                                                             : KindSpecialisation::General;
+}
+inline const char* specialisation_name(KindSpecialisation k) {
+    return k == KindSpecialisation::Triangles ? "triangles" : "general";
+}
+
+/// fn.template operator()<Kinds>() with the KindList of `k`.
+template <class Fn>
+RAYPACK_INLINE decltype(auto) with_kinds(KindSpecialisation k, Fn&& fn) {
+    if (k == KindSpecialisation::Triangles) return fn.template operator()<TriangleKinds>();
+    return fn.template operator()<PrimKinds>();
+}
 
 }  // namespace raypack
