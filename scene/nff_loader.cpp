@@ -10,6 +10,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <vector>
 
 #include "scene/load.h"
@@ -405,8 +406,8 @@ private:
         if (defining_)
             fail(entity_line_, "'begin " + std::string(name) + "' inside object " + quote_token(defining_name_) +
                                    " (begun on line " + std::to_string(defining_line_) + "): objects do not nest");
-        for (std::size_t k = 0; k < scene_.object_names.size(); ++k)
-            if (scene_.object_names[k] == name) fail(entity_line_, "object " + quote_token(name) + " defined twice");
+        if (object_index_.count(std::string(name)) != 0)
+            fail(entity_line_, "object " + quote_token(name) + " defined twice");
         defining_ = std::make_shared<Scene>();
         defining_->source = name_;
         defining_name_ = std::string(name);
@@ -421,6 +422,7 @@ private:
             fail(entity_line_, "object " + quote_token(defining_name_) + " holds " +
                                    std::to_string(defining_->hit_id_count()) +
                                    " primitives with its instances expanded; hits are numbered in 32 bits");
+        object_index_.emplace(defining_name_, std::uint32_t(scene_.objects.size()));
         scene_.objects.push_back(std::move(defining_));
         scene_.object_names.push_back(defining_name_);
         defining_.reset();
@@ -430,13 +432,13 @@ private:
     // row-major affine matrix.
     void instance() {
         const std::string_view name = expect_token("object name");
-        std::size_t k = 0;
-        while (k < scene_.object_names.size() && scene_.object_names[k] != name) ++k;
-        if (k == scene_.object_names.size()) {
+        const auto found = object_index_.find(std::string(name));
+        if (found == object_index_.end()) {
             if (defining_ && name == defining_name_)
                 fail(entity_line_, "object " + quote_token(name) + " places itself (instances cannot be recursive)");
             fail(entity_line_, "unknown object " + quote_token(name) + " (define it with 'begin' ... 'end' first)");
         }
+        const std::uint32_t k = found->second;
         if (scene_.objects[k]->instance_depth() + 1 > kMaxInstanceDepth)
             fail(entity_line_, "placing " + quote_token(name) + " nests instances more than " +
                                    std::to_string(kMaxInstanceDepth) + " levels deep");
@@ -450,7 +452,7 @@ private:
         for (const auto& row : inv.m)
             for (double x : row)
                 if (!std::isfinite(float(x))) fail(tok_.line(), "instance matrix has no finite inverse" + where());
-        target().add_instance(std::uint32_t(k), m, scene_);
+        target().add_instance(k, m, scene_);
         if (!defining_) {
             top_instanced_ids_ += scene_.objects[k]->hit_id_count();
             if (scene_.prims.size() + top_instanced_ids_ > kMaxHitIds - 1)
@@ -551,6 +553,7 @@ private:
     std::string defining_name_;
     int defining_line_ = 0;
     std::uint64_t top_instanced_ids_ = 0;  ///< hit ids of the scene's instances so far
+    std::unordered_map<std::string, std::uint32_t> object_index_;  ///< name -> Scene::objects index
 };
 
 }  // namespace
