@@ -21,7 +21,7 @@ Vec3f smooth_normal(const TriangleSoA& t, std::uint32_t i, const Hitf& hit, cons
 
 namespace {
 
-/// surface_at in scene `in` (the top scene or an object) of the top scene
+/// surface_at in `scene` (the top scene or an object) of the top scene
 /// `top`; `mirrored`: the instances on the way turn space inside out, so a
 /// triangle's winding normal flips as the flattened triangle's would.
 Surface surface_in(const Scene& top, const Scene& scene, const Rayf& ray, const Hitf& hit, bool mirrored) {
