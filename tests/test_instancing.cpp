@@ -14,7 +14,9 @@
 #include "accel/accel.h"
 #include "oracle_harness.h"
 #include "scene_errors.h"
+#include "render/image.h"
 #include "render/surface.h"
+#include "render/whitted.h"
 #include "scene/flatten_instances.h"
 #include "scene/load.h"
 #include "scene/nff_text.h"
@@ -157,6 +159,26 @@ TEST(Instancing, SurfacesAreTheFlattenedScenesSurfaces) {
         EXPECT_LT(length(a.point - b.point), 1e-4f * length(b.point) + 1e-6f) << i;
     }
     EXPECT_GT(compared, rays.size() / 3);
+}
+
+TEST(Instancing, WhittedImageIsTheFlattenedScenes) {
+    // Reflections, shadows and shading through placements (with a mirror and
+    // vertex normals) against the same scene flattened: pixels apart only
+    // where a ray grazes an edge that the transform's rounding moves.
+    const Scene scene = parse(nested_scene_text(3));
+    const Scene flat = flatten_instances(scene);
+    WhittedOptions options;
+    options.width = options.height = 96;
+    Image a, b;
+    const RenderStats sa = render_whitted(scene, *build_accel(scene, accel_config("bvh4")), options, a);
+    const RenderStats sb = render_whitted(flat, *build_accel(flat, accel_config("bvh4")), options, b);
+    EXPECT_GT(sa.eye_hits, 96u * 96u / 4);
+    EXPECT_EQ(sa.eye_hits, sb.eye_hits);
+    EXPECT_GT(sa.shadow_rays, 0u);
+    EXPECT_GT(sa.reflect_rays, 0u);
+    std::size_t apart = 0;
+    for (std::size_t i = 0; i < a.rgb.size(); ++i) apart += std::fabs(a.rgb[i] - b.rgb[i]) > 1e-3f;
+    EXPECT_LE(apart, a.rgb.size() / 200) << "channels differing by more than 1e-3";
 }
 
 TEST(Instancing, ScaledSphereIsAnEllipsoidWithItsAnalyticNormal) {
