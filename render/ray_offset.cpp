@@ -70,11 +70,8 @@ namespace {
 Vec3f point_in(const Scene& top, const Scene& scene, const Rayf& ray, const Hitf& hit) {
     if (hit.prim >= scene.prims.size()) {
         // Inside an instance: the point in object space, placed.
-        const Instance& inst = instance_of_hit_id(scene, hit.prim);
-        const Rayf r{inst.to_object.point(ray.org), inst.to_object.vector(ray.dir), ray.tnear, ray.tfar};
-        Hitf h = hit;
-        h.prim -= inst.first_hit_id;
-        return inst.to_world.point(point_in(top, *top.objects[inst.object], r, h));
+        const HitInPlacement in = hit_in_placement(scene, ray, hit);
+        return in.instance->to_world.point(point_in(top, *top.objects[in.instance->object], in.ray, in.hit));
     }
     const PrimRef ref = scene.prims[hit.prim];
     const std::uint32_t i = ref.index;

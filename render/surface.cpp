@@ -29,12 +29,10 @@ Surface surface_in(const Scene& top, const Scene& scene, const Rayf& ray, const 
         // An instanced primitive: its surface in object space (the ray taken
         // there as the traversal took it), normals back with the inverse
         // transpose (Scene::hit_id_count, accel/prims/instance_prims.h).
-        const Instance& inst = instance_of_hit_id(scene, hit.prim);
-        const Rayf r{inst.to_object.point(ray.org), inst.to_object.vector(ray.dir), ray.tnear, ray.tfar};
-        Hitf h = hit;
-        h.prim -= inst.first_hit_id;
+        const HitInPlacement in = hit_in_placement(scene, ray, hit);
+        const Instance& inst = *in.instance;
         const bool flip = inst.to_world.determinant() < 0;
-        const Surface o = surface_in(top, *top.objects[inst.object], r, h, mirrored != flip);
+        const Surface o = surface_in(top, *top.objects[inst.object], in.ray, in.hit, mirrored != flip);
         Surface w;
         w.point = ray.org + ray.dir * hit.t;
         w.material = o.material;

@@ -9,6 +9,7 @@
 #include "kernels/aabb.h"
 #include "kernels/affine.h"
 #include "kernels/height_field.h"
+#include "kernels/ray.h"
 
 namespace raypack {
 
@@ -235,6 +236,26 @@ ResolvedHit resolve_hit_id(const Scene& top, std::uint32_t id);
 
 /// The instance of `scene` whose hit ids hold `id` (id >= prims.size()).
 const Instance& instance_of_hit_id(const Scene& scene, std::uint32_t id);
+
+/// A ray in an instance's object space, as the traversal takes it there
+/// (the direction not renormalised, so t is unchanged).
+inline Rayf ray_in_object(const Instance& inst, const Rayf& ray) {
+    return {inst.to_object.point(ray.org), inst.to_object.vector(ray.dir), ray.tnear, ray.tfar};
+}
+
+/// A hit inside one of `scene`'s placements, one level down: the
+/// placement, the ray in its object's space and the hit with its id there.
+struct HitInPlacement {
+    const Instance* instance;
+    Rayf ray;
+    Hitf hit;
+};
+inline HitInPlacement hit_in_placement(const Scene& scene, const Rayf& ray, const Hitf& hit) {
+    const Instance& inst = instance_of_hit_id(scene, hit.prim);
+    Hitf h = hit;
+    h.prim -= inst.first_hit_id;
+    return {&inst, ray_in_object(inst, ray), h};
+}
 
 /// Bounds of one primitive and of the whole scene.
 Box3f primitive_bounds(const Scene& scene, std::uint32_t prim);

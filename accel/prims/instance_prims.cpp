@@ -10,16 +10,8 @@ namespace raypack {
 ObjectAccels::ObjectAccels() = default;
 ObjectAccels::~ObjectAccels() = default;
 
-namespace {
-
-Rayf to_object(const Instance& inst, const Rayf& ray) {
-    return {inst.to_object.point(ray.org), inst.to_object.vector(ray.dir), ray.tnear, ray.tfar};
-}
-
-}  // namespace
-
 bool intersect_instance(const Instance& instance, const Accel& object, const Rayf& ray, Hitf& hit) {
-    const Rayf r = to_object(instance, ray);
+    const Rayf r = ray_in_object(instance, ray);
     Hitf h;
     object.intersect({&r, 1}, {&h, 1});
     if (!h.found()) return false;
@@ -33,7 +25,7 @@ std::uint32_t intersect_instance_packet(const Instance& instance, const Accel& o
     assert(width <= 16);
     for (int l = 0; l < width; ++l) {
         if ((active >> l) & 1u) {
-            rays[l] = to_object(instance, rays[l]);
+            rays[l] = ray_in_object(instance, rays[l]);
         } else {
             // An empty span: no structure reports a hit for it.
             rays[l] = Rayf{{0, 0, 0}, {1, 0, 0}, 1.0f, 0.0f};
