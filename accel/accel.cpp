@@ -1,5 +1,6 @@
 #include "accel/accel.h"
 
+#include <chrono>
 #include <stdexcept>
 
 #include "accel/brute/brute_force.h"
@@ -7,6 +8,7 @@
 #include "accel/bvh/wide_bvh_accel.h"
 #include "accel/grid/grid_accel.h"
 #include "accel/kdtree/kdtree_accel.h"
+#include "accel/motion/motion_bvh.h"
 #include "accel/names.h"
 #include "accel/octree/octree_accel.h"
 #ifdef RAYPACK_HAVE_EMBREE
@@ -41,38 +43,79 @@ std::string accel_kinds_list() { return names_joined(accel_kinds()); }
 namespace {
 
 /// A scene with instances: the structures of its objects (built first, in
-/// definition order, so that an object's own instances find theirs) and the
-/// structure over the scene, whose instance primitives point to them. The
-/// queries are the top structure's.
+/// definition order, so that an object's own instances find theirs), the
+/// structure over the scene (whose instance primitives point to them) and,
+/// for moving placements, a motion BVH. Static queries are the top
+/// structure's; a moving placement can only be closer or block, so it is
+/// traced after, with the span cut at the top structure's hit.
 class InstancedAccel final : public Accel {
 public:
-    InstancedAccel(std::unique_ptr<ObjectAccels> objects, std::unique_ptr<Accel> top)
-        : objects_(std::move(objects)), top_(std::move(top)), stats_(top_->stats()) {
+    InstancedAccel(const Scene& scene, std::unique_ptr<ObjectAccels> objects, std::unique_ptr<Accel> top,
+                   std::unique_ptr<MotionBvh> motion, double motion_build_ms)
+        : scene_(scene), objects_(std::move(objects)), top_(std::move(top)), motion_(std::move(motion)),
+          stats_(top_->stats()) {
         for (const auto& o : objects_->accels) {
             stats_.bytes += o->stats().bytes;
             stats_.build_ms += o->stats().build_ms;
         }
+        if (motion_) {
+            stats_.bytes += motion_->bytes();
+            stats_.nodes += motion_->node_count();
+            stats_.build_ms += motion_build_ms;
+        }
     }
-    void intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const override { top_->intersect(rays, hits); }
+    void intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const override {
+        top_->intersect(rays, hits);
+        add_motion(rays, {}, hits);
+    }
     void occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override {
         top_->occluded(rays, occluded);
+        add_motion(rays, {}, occluded);
     }
     const AccelStats& stats() const override { return stats_; }
     bool supports_packet(int width) const override { return top_->supports_packet(width); }
     void intersect_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const override {
         top_->intersect_packets(width, rays, hits);
+        add_motion(rays, {}, hits);
     }
     void occluded_packets(int width, std::span<const Rayf> rays, std::span<std::uint8_t> out) const override {
         top_->occluded_packets(width, rays, out);
+        add_motion(rays, {}, out);
+    }
+    void intersect_at(int width, std::span<const Rayf> rays, std::span<const float> times,
+                      std::span<Hitf> hits) const override {
+        top_->intersect_packets(width, rays, hits);
+        add_motion(rays, times, hits);
+    }
+    void occluded_at(int width, std::span<const Rayf> rays, std::span<const float> times,
+                     std::span<std::uint8_t> out) const override {
+        top_->occluded_packets(width, rays, out);
+        add_motion(rays, times, out);
     }
     bool count_traversal(std::span<const Rayf> rays, bool any_hit, std::span<Hitf> hits,
                          TraversalCounts& counts) const override {
-        return top_->count_traversal(rays, any_hit, hits, counts);
+        return !motion_ && top_->count_traversal(rays, any_hit, hits, counts);
     }
 
 private:
+    /// Ray i at shutter fraction of times[i] (the opening without times).
+    float fraction(std::span<const float> times, std::size_t i) const {
+        return times.empty() ? 0.0f : scene_.shutter_fraction(times[i]);
+    }
+    void add_motion(std::span<const Rayf> rays, std::span<const float> times, std::span<Hitf> hits) const {
+        if (!motion_) return;
+        for (std::size_t i = 0; i < rays.size(); ++i) motion_->intersect(rays[i], fraction(times, i), hits[i]);
+    }
+    void add_motion(std::span<const Rayf> rays, std::span<const float> times, std::span<std::uint8_t> out) const {
+        if (!motion_) return;
+        for (std::size_t i = 0; i < rays.size(); ++i)
+            if (!out[i]) out[i] = motion_->occluded(rays[i], fraction(times, i)) ? 1 : 0;
+    }
+
+    const Scene& scene_;
     std::unique_ptr<ObjectAccels> objects_;
     std::unique_ptr<Accel> top_;
+    std::unique_ptr<MotionBvh> motion_;
     AccelStats stats_;
 };
 
@@ -82,13 +125,20 @@ std::unique_ptr<Accel> build_one(const Scene& scene, const AccelConfig& config);
 
 std::unique_ptr<Accel> build_accel(const Scene& scene, const AccelConfig& config) {
     // Embree refuses instances itself.
-    if (scene.instances.empty() || is_embree_kind(config.kind)) return build_one(scene, config);
+    if (!scene.placements() || is_embree_kind(config.kind)) return build_one(scene, config);
     auto objects = std::make_unique<ObjectAccels>();
     AccelConfig with_objects = config;
     with_objects.kernels.objects = objects.get();
     for (const auto& object : scene.objects) objects->accels.push_back(build_one(*object, with_objects));
     auto top = build_one(scene, with_objects);
-    return std::make_unique<InstancedAccel>(std::move(objects), std::move(top));
+    std::unique_ptr<MotionBvh> motion;
+    double motion_ms = 0;
+    if (!scene.moving_instances.empty()) {
+        const auto start = std::chrono::steady_clock::now();
+        motion = std::make_unique<MotionBvh>(scene, *objects, config.kind == "brute");
+        motion_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    }
+    return std::make_unique<InstancedAccel>(scene, std::move(objects), std::move(top), std::move(motion), motion_ms);
 }
 
 namespace {

@@ -87,6 +87,22 @@ public:
         occluded(rays, occluded_out);
     }
 
+    /// The same queries for rays at times: times[i] is ray i's scene time
+    /// (Scene::shutter_fraction), and moving placements (Scene::
+    /// moving_instances) sit where they are at that time. The queries above
+    /// trace every ray at the shutter's opening. A structure of a static
+    /// scene ignores the times.
+    virtual void intersect_at(int width, std::span<const Rayf> rays, std::span<const float> times,
+                              std::span<Hitf> hits) const {
+        (void)times;
+        intersect_packets(width, rays, hits);
+    }
+    virtual void occluded_at(int width, std::span<const Rayf> rays, std::span<const float> times,
+                             std::span<std::uint8_t> occluded_out) const {
+        (void)times;
+        occluded_packets(width, rays, occluded_out);
+    }
+
     /// Traces each ray alone, in the order of the single-ray path, adding its
     /// work to `counts`; hits[i] gets the answer (any_hit: found() = occluded).
     /// Never on a timed path. False where the structure cannot count (Embree).

@@ -13,13 +13,14 @@ namespace raypack::app {
 int run_gen(const Args& args) {
     const ParsedArgs p(args,
                        {{"--size", "-s", 1}, {"--output", "-o", 1}, {"--area-lights", "", 0}, {"--lens", "", 0},
-                        {"--glossy", "", 0}},
+                        {"--glossy", "", 0}, {"--motion", "", 0}},
                        1);
     if (p.help() || p.positional().empty()) {
-        std::printf("usage: raypack gen NAME --size S [--area-lights] [--lens] [--glossy] -o FILE.nff\n"
+        std::printf("usage: raypack gen NAME --size S [--area-lights] [--lens] [--glossy] [--motion] -o FILE.nff\n"
                     "  --area-lights  point lights become spherical area lights (ls)\n"
                     "  --lens         a thin lens focused on the view point (lens)\n"
                     "  --glossy       glossy instead of mirror surfaces (gloss 40)\n"
+                    "  --motion       every sphere moves by 1.5 radii over the shutter (move; motion blur)\n"
                     "generators (default size, max):");
         for (const auto& g : spd_generators()) std::printf(" %s (%d, %d)", g.name.c_str(), g.default_size, g.max_size);
         std::printf("\n");
@@ -42,6 +43,7 @@ int run_gen(const Args& args) {
         v.area_lights = p.has("--area-lights");
         v.lens = p.has("--lens");
         v.glossy = p.has("--glossy");
+        v.motion = p.has("--motion");
         if (v.any()) text = apply_scene_variants(text, v);
     } catch (const std::invalid_argument& e) {
         throw UsageError(e.what());

@@ -31,11 +31,14 @@ int run_info(const Args& args) {
         std::printf("  height fields %zu (%zu samples, %.1f MiB with their min/max pyramids)\n",
                     scene.height_fields.size(), samples, double(bytes) / (1 << 20));
     }
-    if (!scene.instances.empty()) {
+    if (scene.placements()) {
         std::size_t stored = 0;
         for (const auto& o : scene.objects) stored += o->primitive_count() - o->instances.size();
         std::printf("  instances  %zu of %zu objects (%zu primitives stored in the objects)\n",
-                    scene.instances.size(), scene.objects.size(), stored);
+                    scene.instances.size() + scene.moving_instances.size(), scene.objects.size(), stored);
+        if (!scene.moving_instances.empty())
+            std::printf("  moving     %zu of them over the shutter [%g, %g]\n", scene.moving_instances.size(),
+                        double(scene.shutter_open), double(scene.shutter_close));
         std::printf("primitives as instanced: %llu (with every instance expanded)\n",
                     static_cast<unsigned long long>(scene.instanced_primitive_count()));
     }

@@ -36,6 +36,7 @@ std::vector<std::string> feature_names(const Features& f) {
                                                   {f.cones, "cones"},
                                                   {f.height_fields, "height-fields"},
                                                   {f.instances, "instances"},
+                                                  {f.motion, "motion"},
                                                   {f.vertex_normals, "vertex-normals"},
                                                   {f.reflection, "reflection"},
                                                   {f.transmission, "transmission"},

@@ -12,7 +12,10 @@ namespace raypack {
 
 struct CameraSampleBatch {
     std::vector<Sampler::Draw> keys;  ///< per sample, pixel by pixel: samples k0 .. k1 of each
-    std::vector<Sample2> position, lens;
+    std::vector<Sample2> position, lens, time_drawn;
+    /// Per sample, its scene time (motion blur: scenes with moving
+    /// placements), spread over the shutter; empty for a static scene.
+    std::vector<float> time;
 
     /// Samples k0 .. k1 of every pixel of `pixels` (numbered y * width + x):
     /// their keys, and their rays in rays[0 .. pixels * (k1 - k0)). Positions
@@ -21,6 +24,14 @@ struct CameraSampleBatch {
     /// other).
     void draw(const CameraFrame& frame, const Camera& camera, const Sampler& sampler, PixelFilter filter,
               std::span<const PixelXY> pixels, int width, int k0, int k1, Rayf* rays) {
+        draw(frame, camera, sampler, filter, pixels, width, k0, k1, rays, nullptr);
+    }
+    /// The same, and with a scene that moves (`scene` not null, with moving
+    /// placements) each sample's time from sampler dimension kTimeDimension.
+    void draw(const CameraFrame& frame, const Camera& camera, const Sampler& sampler, PixelFilter filter,
+              std::span<const PixelXY> pixels, int width, int k0, int k1, Rayf* rays, const Scene* scene) {
+        motion = scene != nullptr && !scene->moving_instances.empty();
+        if (motion) shutter_open = scene->shutter_open, shutter_close = scene->shutter_close;
         keys.clear();
         for (const PixelXY& px : pixels) {
             const Sampler::Pixel pixel = sampler.pixel(std::uint64_t(px.y) * std::uint64_t(width) + std::uint64_t(px.x));
@@ -30,11 +41,24 @@ struct CameraSampleBatch {
         lens.assign(keys.size(), Sample2{});
         sampler.get_many(keys, 0, position.data());
         if (camera.lens_radius > 0) sampler.get_many(keys, 1, lens.data());
+        time.clear();
+        if (motion) {
+            time_drawn.resize(keys.size());
+            sampler.get_many(keys, kTimeDimension, time_drawn.data());
+            time.resize(keys.size());
+            for (std::size_t j = 0; j < keys.size(); ++j) time[j] = shutter_time(sampler.line(time_drawn[j]));
+        }
         std::size_t i = 0;
         for (const PixelXY& px : pixels)
             for (int k = k0; k < k1; ++k, ++i)
                 rays[i] = camera_ray_of_sample(frame, camera, filter, position[i], lens[i], px.x, px.y);
     }
+
+private:
+    bool motion = false;
+    float shutter_open = 0, shutter_close = 1;
+    /// (1 - u) t0 + u t1: t0 at u = 0.
+    float shutter_time(float u) const { return (1.0f - u) * shutter_open + u * shutter_close; }
 };
 
 }  // namespace raypack

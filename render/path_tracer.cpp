@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <numbers>
 #include <vector>
@@ -106,6 +107,7 @@ struct Scratch {
     std::vector<std::int32_t> draw_of;
     std::vector<Sample2> bounce_draws[4];
     std::vector<Vec3f> radiance;      ///< per sample of the tile
+    std::vector<float> times;         ///< moving scenes: per ray of a query, its sample's time
     Paths paths, next;
     Shadows shadows;
     RenderStats stats;
@@ -120,7 +122,8 @@ public:
           path_(path),
           offset_(options.offset, scene),
           surfaces_(scene),
-          samples_(options.sampler, options.spp, options.seed) {}
+          samples_(options.sampler, options.spp, options.seed),
+          timed_(!scene.moving_instances.empty()) {}
 
     const Sampler& samples() const { return samples_; }
 
@@ -130,7 +133,9 @@ public:
         s.stats.eye_rays += s.paths.rays.size();
         for (int depth = 1; !s.paths.rays.empty(); ++depth) {
             Paths& p = s.paths;
-            accel_.intersect_packets(depth == 1 ? options_.packet : options_.secondary_packet, p.rays, p.hits);
+            const int width = depth == 1 ? options_.packet : options_.secondary_packet;
+            if (timed_) accel_.intersect_at(width, p.rays, times_of(p.sample, s), p.hits);
+            else accel_.intersect_packets(width, p.rays, p.hits);
             if (depth == 1)
                 for (const Hitf& h : p.hits) s.stats.eye_hits += h.found();
             s.next.clear();
@@ -150,6 +155,14 @@ private:
     RayOffset offset_;
     SurfaceTable surfaces_;
     Sampler samples_;
+    bool timed_;  ///< the scene moves: every ray at its camera sample's time
+
+    /// The times of rays whose samples are `samples` (indices into the batch).
+    static std::span<const float> times_of(std::span<const std::uint32_t> samples, Scratch& s) {
+        s.times.resize(samples.size());
+        for (std::size_t k = 0; k < samples.size(); ++k) s.times[k] = s.camera.time[samples[k]];
+        return s.times;
+    }
 
     /// Dimensions of the bounce at `depth`: part choice and roulette, light
     /// choice, point on the light, direction of the bounce.
@@ -189,7 +202,8 @@ private:
             L += beta * scene_.background;
             return;
         }
-        const Surface surf = surfaces_.at(ray, hit);
+        const float time = timed_ ? s.camera.time[si] : -std::numeric_limits<float>::infinity();
+        const Surface surf = surfaces_.at(ray, hit, time);
         const Material& m = scene_.materials[surf.material];
         const Vec3f wo = -normalize(ray.dir);
         const bool front = dot(wo, surf.geometric_normal) > 0;
@@ -213,7 +227,7 @@ private:
         }
         if (depth >= path_.max_depth) return;
 
-        const Vec3f hp = offset_.hit_point(scene_, ray, hit, surf.point);
+        const Vec3f hp = offset_.hit_point(scene_, ray, hit, surf.point, time);
         const Vec3f above = offset_.offset(hp, ng);
         // Choose one of the material's three parts in proportion to its weight.
         const Vec3f albedo = m.color * m.kd;
@@ -351,7 +365,8 @@ private:
         Shadows& b = s.shadows;
         if (b.rays.empty()) return;
         b.occluded.resize(b.rays.size());
-        accel_.occluded_packets(options_.secondary_packet, b.rays, b.occluded);
+        if (timed_) accel_.occluded_at(options_.secondary_packet, b.rays, times_of(b.sample, s), b.occluded);
+        else accel_.occluded_packets(options_.secondary_packet, b.rays, b.occluded);
         for (std::size_t k = 0; k < b.rays.size(); ++k)
             if (!b.occluded[k]) s.radiance[b.sample[k]] += b.contribution[k];
     }
@@ -381,7 +396,7 @@ RenderStats render_path(const Scene& scene, const Accel& accel, const WhittedOpt
             s.paths.start_camera_paths(n);
             s.radiance.assign(n, Vec3f{});
             s.camera.draw(frame, scene.camera, tracer.samples(), options.filter, s.pixels, options.width, k0, k1,
-                          s.paths.rays.data());
+                          s.paths.rays.data(), &scene);
             tracer.trace(s);
             std::size_t i = 0;
             for (const PixelXY& px : s.pixels) {

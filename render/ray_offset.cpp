@@ -67,11 +67,11 @@ namespace {
 
 /// accurate_hit_point in scene `scene` (the top scene or an object) of the
 /// top scene `top`.
-Vec3f point_in(const Scene& top, const Scene& scene, const Rayf& ray, const Hitf& hit) {
+Vec3f point_in(const Scene& top, const Scene& scene, const Rayf& ray, const Hitf& hit, float time) {
     if (hit.prim >= scene.prims.size()) {
         // Inside an instance: the point in object space, placed.
-        const HitInPlacement in = hit_in_placement(scene, ray, hit);
-        return in.instance->to_world.point(point_in(top, *top.objects[in.instance->object], in.ray, in.hit));
+        const HitInPlacement in = hit_in_placement(scene, ray, hit, time);
+        return in.to_world.point(point_in(top, *top.objects[in.instance->object], in.ray, in.hit, time));
     }
     const PrimRef ref = scene.prims[hit.prim];
     const std::uint32_t i = ref.index;
@@ -97,8 +97,8 @@ Vec3f point_in(const Scene& top, const Scene& scene, const Rayf& ray, const Hitf
 
 }  // namespace
 
-Vec3f accurate_hit_point(const Scene& scene, const Rayf& ray, const Hitf& hit) {
-    return point_in(scene, scene, ray, hit);
+Vec3f accurate_hit_point(const Scene& scene, const Rayf& ray, const Hitf& hit, float time) {
+    return point_in(scene, scene, ray, hit, time);
 }
 
 RayOffset::RayOffset(OffsetPolicy policy, const Scene& scene) : policy_(policy), scene_extent_(1.0f) {

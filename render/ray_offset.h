@@ -34,8 +34,9 @@ std::string offset_policy_list();
 /// The hit point as accurately as float allows: for triangles from the
 /// barycentrics (the vertices carry no error, org + t dir carries the error
 /// of t times |dir|), for spheres org + t dir projected back onto the sphere,
-/// for cones org + t dir (Waechter & Binder, RTG ch. 6.2).
-Vec3f accurate_hit_point(const Scene& scene, const Rayf& ray, const Hitf& hit);
+/// for cones org + t dir (Waechter & Binder, RTG ch. 6.2). `time`: the
+/// ray's scene time (surface_at).
+Vec3f accurate_hit_point(const Scene& scene, const Rayf& ray, const Hitf& hit, float time = -std::numeric_limits<float>::infinity());
 
 /// Moves secondary-ray origins off surfaces by one policy.
 class RayOffset {
@@ -50,8 +51,9 @@ public:
     /// The point secondary rays leave from before the offset: robust takes
     /// accurate_hit_point, as the chapter requires (its 256 ULPs cover the
     /// error of that point, not of org + t dir); the others `surface_point`.
-    Vec3f hit_point(const Scene& scene, const Rayf& ray, const Hitf& hit, const Vec3f& surface_point) const {
-        return policy_ == OffsetPolicy::Robust ? accurate_hit_point(scene, ray, hit) : surface_point;
+    Vec3f hit_point(const Scene& scene, const Rayf& ray, const Hitf& hit, const Vec3f& surface_point,
+                    float time = -std::numeric_limits<float>::infinity()) const {
+        return policy_ == OffsetPolicy::Robust ? accurate_hit_point(scene, ray, hit, time) : surface_point;
     }
 
     /// `p` moved to the side unit normal `n` points to.

@@ -2,6 +2,7 @@
 // Sample points of the unit square for pixel samples (image position, lens,
 // light, lobe, time): each is a pure function of (seed, pixel, sample index,
 // dimension), so an image does not depend on thread count or tile order.
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -36,6 +37,10 @@ StrataGrid strata_grid(int spp);
 /// Sample `index` (0 <= index < spp) of pixel `pixel` in the 2D dimension
 /// `dimension` (0 = position in the pixel, then lens, light, lobe, time ...
 /// as the integrator numbers them).
+/// The sampler dimension of a camera sample's time (motion blur), apart
+/// from the integrators' own (position, lens, lobes, bounces).
+inline constexpr int kTimeDimension = 1 << 20;
+
 class Sampler {
 public:
     Sampler(SamplerKind kind, int spp, std::uint64_t seed);
@@ -61,6 +66,17 @@ public:
     /// AVX-512 (the stratified sampler with power-of-two strata, and the
     /// random one; the others draw one by one).
     void get_many(std::span<const Draw> draws, int dimension, Sample2* out) const;
+
+    /// A point of [0, 1) from a 2D sample: the column of the strata grid
+    /// that u.x falls in, refined by u.y, so that the regular and stratified
+    /// samplers' spp samples fall one in each of spp equal intervals (a
+    /// 1D stratification from the 2D one), and a uniform u gives a uniform
+    /// point. For one-dimensional draws such as the time of a sample.
+    float line(Sample2 u) const {
+        const float column = std::floor(u.x * float(grid_.nx));
+        const float t = (column + u.y) / float(grid_.nx);
+        return t < 1.0f ? t : 0x1.fffffep-1f;
+    }
 
     SamplerKind kind() const { return kind_; }
     int spp() const { return spp_; }

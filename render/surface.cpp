@@ -24,20 +24,20 @@ namespace {
 /// surface_at in `scene` (the top scene or an object) of the top scene
 /// `top`; `mirrored`: the instances on the way turn space inside out, so a
 /// triangle's winding normal flips as the flattened triangle's would.
-Surface surface_in(const Scene& top, const Scene& scene, const Rayf& ray, const Hitf& hit, bool mirrored) {
+Surface surface_in(const Scene& top, const Scene& scene, const Rayf& ray, const Hitf& hit, bool mirrored,
+                   float time) {
     if (hit.prim >= scene.prims.size()) {
         // An instanced primitive: its surface in object space (the ray taken
         // there as the traversal took it), normals back with the inverse
         // transpose (Scene::hit_id_count, accel/prims/instance_prims.h).
-        const HitInPlacement in = hit_in_placement(scene, ray, hit);
-        const Instance& inst = *in.instance;
-        const bool flip = inst.to_world.determinant() < 0;
-        const Surface o = surface_in(top, *top.objects[inst.object], in.ray, in.hit, mirrored != flip);
+        const HitInPlacement in = hit_in_placement(scene, ray, hit, time);
+        const bool flip = in.to_world.determinant() < 0;
+        const Surface o = surface_in(top, *top.objects[in.instance->object], in.ray, in.hit, mirrored != flip, time);
         Surface w;
         w.point = ray.org + ray.dir * hit.t;
         w.material = o.material;
-        w.geometric_normal = normalize(inst.to_object.transposed_vector(o.geometric_normal));
-        w.shading_normal = normalize(inst.to_object.transposed_vector(o.shading_normal));
+        w.geometric_normal = normalize(in.to_object.transposed_vector(o.geometric_normal));
+        w.shading_normal = normalize(in.to_object.transposed_vector(o.shading_normal));
         return w;
     }
     Surface s;
@@ -74,8 +74,8 @@ Surface surface_in(const Scene& top, const Scene& scene, const Rayf& ray, const 
 
 }  // namespace
 
-Surface surface_at(const Scene& scene, const Rayf& ray, const Hitf& hit) {
-    return surface_in(scene, scene, ray, hit, false);
+Surface surface_at(const Scene& scene, const Rayf& ray, const Hitf& hit, float time) {
+    return surface_in(scene, scene, ray, hit, false, time);
 }
 
 

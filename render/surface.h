@@ -1,5 +1,6 @@
 #pragma once
 // What shading needs to know about a hit: position, normals, material.
+#include <limits>
 #include <vector>
 
 #include "kernels/ray.h"
@@ -14,8 +15,9 @@ struct Surface {
     std::uint32_t material = 0;
 };
 
-/// Surface at a found hit of `ray`.
-Surface surface_at(const Scene& scene, const Rayf& ray, const Hitf& hit);
+/// Surface at a found hit of `ray` at scene time `time` (-inf: the
+/// shutter's opening; only moving placements depend on it).
+Surface surface_at(const Scene& scene, const Rayf& ray, const Hitf& hit, float time = -std::numeric_limits<float>::infinity());
 
 /// The interpolated normal of triangle i at the hit's barycentrics, or the
 /// geometric normal `ng` where it vanishes (surface_at's shading normal).
@@ -31,7 +33,7 @@ public:
     explicit SurfaceTable(const Scene& scene);
     /// Inline: out of line, the returned Surface went through the stack and
     /// its copy stalled on store forwarding in the shading loops.
-    Surface at(const Rayf& ray, const Hitf& hit) const;
+    Surface at(const Rayf& ray, const Hitf& hit, float time = -std::numeric_limits<float>::infinity()) const;
 
 private:
     enum Kind : std::uint32_t { kFlatTriangle, kSmoothTriangle, kSphere, kOther };
@@ -44,8 +46,8 @@ private:
     std::vector<Record> records_;
 };
 
-inline Surface SurfaceTable::at(const Rayf& ray, const Hitf& hit) const {
-    if (hit.prim >= records_.size()) return surface_at(scene_, ray, hit);  // inside an instance
+inline Surface SurfaceTable::at(const Rayf& ray, const Hitf& hit, float time) const {
+    if (hit.prim >= records_.size()) return surface_at(scene_, ray, hit, time);  // inside an instance
     const Record r = records_[hit.prim];
     Surface s;
     s.point = ray.org + ray.dir * hit.t;

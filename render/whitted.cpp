@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -52,6 +53,9 @@ struct RayTree {
     std::vector<Hitf> hits;
     std::vector<Vec3f> color;
     std::vector<std::uint64_t> sample;  ///< pixel * spp + sample index of the camera sample
+    /// Scene time of each ray (its camera sample's), when the scene moves
+    /// and the render samples time; otherwise unused.
+    std::vector<float> time;
     std::vector<Link> links;            ///< in the order of their parents
     std::size_t count = 0;              ///< rays in use; the arrays only grow
 
@@ -75,6 +79,7 @@ private:
         hits.resize(size);
         color.resize(size);
         sample.resize(size);
+        time.resize(size);
     }
 };
 
@@ -83,6 +88,7 @@ private:
 struct ShadowBatch {
     std::vector<ShadowQueue> per_light;
     std::vector<Rayf> all;
+    std::vector<float> times;  ///< moving scenes: each ray's, its owner's
     std::vector<std::uint8_t> occluded;
 
     void reset(std::size_t lights) {
@@ -127,7 +133,10 @@ public:
           samples_(options.distribution ? options.sampler : SamplerKind::Regular,
                    options.distribution ? options.spp : 1, options.seed),
           light_samples_(options.distribution ? options.sampler : SamplerKind::Regular,
-                         options.distribution ? options.light_samples : 1, options.seed ^ 0x5bd1e995ull) {
+                         options.distribution ? options.light_samples : 1, options.seed ^ 0x5bd1e995ull),
+          // Whitted traces every ray at the shutter's opening (one sample,
+          // no time); distribution ray tracing samples time per camera sample.
+          timed_(options.distribution && !scene.moving_instances.empty()) {
         specular_cutoff_.reserve(scene.materials.size());
         for (const Material& m : scene.materials) specular_cutoff_.push_back(specular_cutoff(m.shine));
     }
@@ -141,7 +150,9 @@ public:
     /// distribution ray tracing: positions drawn from the pixel filter
     /// (sampler dimension 0) and lens points (dimension 1), all at once.
     void camera_samples(std::span<const PixelXY> pixels, int k0, int k1, const CameraFrame& frame, Scratch& s) const {
-        s.camera.draw(frame, scene_.camera, samples_, options_.filter, pixels, options_.width, k0, k1, s.tree.rays.data());
+        s.camera.draw(frame, scene_.camera, samples_, options_.filter, pixels, options_.width, k0, k1, s.tree.rays.data(),
+                      &scene_);
+        if (timed_) std::copy(s.camera.time.begin(), s.camera.time.end(), s.tree.time.begin());
         const auto spp = std::uint64_t(samples_.spp());
         std::size_t i = 0;
         for (const PixelXY& px : pixels) {
@@ -156,16 +167,23 @@ public:
         return samples_.get(key / spp, int(key % spp), 1);
     }
 
+    /// Whether rays carry times (RayTree::time).
+    bool timed() const { return timed_; }
+    /// The scene time of the sample with key `key` (dimension kTimeDimension).
+    float time_sample(std::uint64_t key) const {
+        const auto spp = std::uint64_t(samples_.spp());
+        const float u = samples_.line(samples_.get(key / spp, int(key % spp), kTimeDimension));
+        return (1.0f - u) * scene_.shutter_open + u * scene_.shutter_close;
+    }
+
     /// Traces the whole ray tree of the eye rays s.tree.rays[0 .. eye) (set
     /// after s.tree.reset(eye)); their colours end in s.tree.color[0 .. eye).
     void trace(std::size_t eye, Scratch& s) const {
         RayTree& tree = s.tree;
-        accel_.intersect_packets(options_.packet, std::span(tree.rays).first(eye), std::span(tree.hits).first(eye));
+        intersect(options_.packet, 0, eye, tree);
         std::size_t begin = 0, end = eye;
         for (int depth = 1; begin < end; ++depth) {
-            if (depth > 1)
-                accel_.intersect_packets(options_.secondary_packet, std::span(tree.rays).subspan(begin, end - begin),
-                                         std::span(tree.hits).subspan(begin, end - begin));
+            if (depth > 1) intersect(options_.secondary_packet, begin, end, tree);
             shade_level(begin, end, depth, s);
             begin = end;
             end = tree.count;
@@ -194,6 +212,15 @@ private:
     std::vector<float> specular_cutoff_;  ///< per material, see specular_cutoff
     Sampler samples_;        ///< camera samples: pixel position, lens, glossy lobes
     Sampler light_samples_;  ///< points on area lights
+    bool timed_;             ///< rays carry times (RayTree::time)
+
+    /// Closest hits of the tree's rays [begin, end), at their times if timed.
+    void intersect(int width, std::size_t begin, std::size_t end, RayTree& tree) const {
+        const auto rays = std::span(tree.rays).subspan(begin, end - begin);
+        const auto hits = std::span(tree.hits).subspan(begin, end - begin);
+        if (timed_) accel_.intersect_at(width, rays, std::span(tree.time).subspan(begin, end - begin), hits);
+        else accel_.intersect_packets(width, rays, hits);
+    }
 
     /// Shades the rays [begin, end) of the tree, which are of depth `depth`:
     /// first each hit's surface (in ray order), then each point light for
@@ -239,7 +266,8 @@ private:
     /// (or the colour of the area light it lies on).
     void add_point(std::int32_t i, const Rayf& ray, const Hitf& hit, Scratch& s) const {
         RayTree& tree = s.tree;
-        const Surface surf = surfaces_.at(ray, hit);
+        const float time = timed_ ? tree.time[std::size_t(i)] : -std::numeric_limits<float>::infinity();
+        const Surface surf = surfaces_.at(ray, hit, time);
         const Material& m = scene_.materials[surf.material];
         if (m.area_light >= 0) {
             // A light's own surface shows the light's colour.
@@ -252,7 +280,7 @@ private:
         const Vec3f ng = toward(surf.geometric_normal, front);
         Vec3f ns = toward(surf.shading_normal, front);
         if (dot(ns, ng) < 0) ns = ng;  // interpolated normal bent past the surface
-        const Vec3f p = offset_.hit_point(scene_, ray, hit, surf.point);
+        const Vec3f p = offset_.hit_point(scene_, ray, hit, surf.point, time);
         tree.color[std::size_t(i)] = m.color * (intensity_ * m.kd);  // ambient
         s.points.add(i, view, ns, ng, offset_.offset(p, ng), m, specular_cutoff_[surf.material]);
         s.spawn.push_back({p, surf.material, front});
@@ -347,6 +375,7 @@ private:
         link.reflect = tree.add();
         link.ks = m.ks;
         tree.sample[std::size_t(link.reflect)] = tree.sample[std::size_t(i)];
+        tree.time[std::size_t(link.reflect)] = tree.time[std::size_t(i)];
         spawn_ray(pts.above(j), reflected_dir, offset_, tree.rays[std::size_t(link.reflect)]);
         if (m.transmittance > 0) {
             link.kt = m.transmittance;
@@ -359,6 +388,7 @@ private:
                 const Vec3f dir = view * eta + ns * (eta * cos_i - std::sqrt(k));
                 const std::int32_t child = tree.add();
                 tree.sample[std::size_t(child)] = tree.sample[std::size_t(i)];
+                tree.time[std::size_t(child)] = tree.time[std::size_t(i)];
                 spawn_ray(offset_.offset(sp.p, -ng), dir, offset_, tree.rays[std::size_t(child)]);
                 link.refract = child;
             }
@@ -394,7 +424,14 @@ private:
         for (const ShadowQueue& q : b.per_light) b.all.insert(b.all.end(), q.rays.begin(), q.rays.end());
         if (b.all.empty()) return;
         b.occluded.resize(b.all.size());
-        accel_.occluded_packets(options_.secondary_packet, b.all, b.occluded);
+        if (timed_) {
+            b.times.clear();
+            for (const ShadowQueue& q : b.per_light)
+                for (const std::int32_t owner : q.owner) b.times.push_back(s.tree.time[std::size_t(owner)]);
+            accel_.occluded_at(options_.secondary_packet, b.all, b.times, b.occluded);
+        } else {
+            accel_.occluded_packets(options_.secondary_packet, b.all, b.occluded);
+        }
         std::size_t k = 0;
         for (const ShadowQueue& q : b.per_light)
             for (std::size_t j = 0; j < q.rays.size(); ++j, ++k)
@@ -457,6 +494,7 @@ RenderStats render_adaptive(const Scene& scene, const Accel& accel, const Whitte
                 s.tree.rays[i] = thin_lens_ray(frame, px, py, tracer.lens_sample(key), scene.camera.lens_radius,
                                                scene.camera.focus_distance);
                 s.tree.sample[i] = key;
+                if (tracer.timed()) s.tree.time[i] = tracer.time_sample(key);
             }
             tracer.trace(batch.size(), s);
             points.fetch_add(batch.size(), std::memory_order_relaxed);

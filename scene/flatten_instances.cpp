@@ -108,6 +108,10 @@ private:
 
 Scene flatten_instances(const Scene& scene, std::vector<std::uint32_t>* hit_ids) {
     if (hit_ids != nullptr) hit_ids->clear();
+    if (!scene.moving_instances.empty())
+        throw SceneError(scene.source, 0, "cannot flatten the instances: " +
+                                              std::to_string(scene.moving_instances.size()) +
+                                              " placements move, and a flattened scene is static");
     if (scene.instances.empty()) {
         if (hit_ids != nullptr)
             for (std::uint32_t p = 0; p < scene.prims.size(); ++p) hit_ids->push_back(p);

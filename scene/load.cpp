@@ -47,7 +47,7 @@ Scene load_generated(const std::string& spec) {
         if (!variants || !variants->any())
             throw SceneError(spec, 0,
                              "bad generator spec: variants '" + std::string(size_text.substr(second + 1)) +
-                                 "' (expected area-lights, lens, glossy joined by '+')");
+                                 "' (expected area-lights, lens, glossy, motion joined by '+')");
         size_text = size_text.substr(0, second);
     }
     long long size = 0;

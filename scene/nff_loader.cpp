@@ -121,6 +121,8 @@ public:
             else if (kw == "begin") begin_object();
             else if (kw == "end") end_object();
             else if (kw == "inst") instance();
+            else if (kw == "move") move();
+            else if (kw == "shutter") shutter();
             else if (float x; parse_float_token(kw, x) != NumberToken::NotNumber)
                 fail(entity_line_, "unexpected number " + quote_token(kw) +
                                        " where an entity keyword was expected (too many values before it?)");
@@ -130,6 +132,7 @@ public:
         if (defining_)
             fail(entity_line_, "object " + quote_token(defining_name_) + " begun on line " +
                                    std::to_string(defining_line_) + " has no 'end'");
+        close_moving_group();
         scene_.has_camera = camera_line_ != 0;
         scene_.update_features();
         if (scene_.hit_id_count() > kMaxHitIds - 1)
@@ -389,8 +392,82 @@ private:
             if (!std::isfinite(z)) fail(entity_line_, "hf " + quote_token(file) + ": non-finite pixel value");
     }
 
-    /// Primitives go to the object being defined, else to the scene.
-    Scene& target() { return defining_ ? *defining_ : scene_; }
+    /// Primitives go to the object being defined, else while a `move` is in
+    /// force to the moving group, else to the scene.
+    Scene& target() {
+        if (defining_) return *defining_;
+        if (move_ == Vec3f{}) return scene_;
+        if (!moving_group_) {
+            moving_group_ = std::make_shared<Scene>();
+            moving_group_->source = name_;
+        }
+        return *moving_group_;
+    }
+
+    // `move dx dy dz`: the primitives and instances that follow move by
+    // (dx, dy, dz) over the shutter. The primitives of one `move` form an
+    // object of their own, placed by a moving instance from the identity to
+    // the translation: one placement for the group, so a group of many
+    // primitives gets one structure of its own.
+    void move() {
+        if (defining_)
+            fail(entity_line_, "'move' inside object " + quote_token(defining_name_) +
+                                   ": objects are static (move their placements instead)");
+        const Vec3f d = vec3("motion");
+        close_moving_group();
+        move_ = d;
+        move_line_ = entity_line_;
+    }
+
+    /// Places the primitives gathered under the last `move`, if any.
+    void close_moving_group() {
+        if (!moving_group_) return;
+        moving_group_->update_features(&scene_);
+        const auto k = std::uint32_t(scene_.objects.size());
+        const std::string name = "move on line " + std::to_string(move_line_);
+        scene_.objects.push_back(std::move(moving_group_));
+        scene_.object_names.push_back(name);
+        moving_group_.reset();
+        Affine3f end;
+        end.m[0][3] = move_.x, end.m[1][3] = move_.y, end.m[2][3] = move_.z;
+        scene_.add_moving_instance(k, Affine3f{}, end, scene_);
+        count_top_ids(k);
+    }
+
+    // `shutter t0 t1`: the times rays may carry; motion runs from t0 to t1.
+    void shutter() {
+        if (shutter_line_ != 0)
+            fail(entity_line_, "second 'shutter' line (the first is on line " + std::to_string(shutter_line_) + ")");
+        const float t0 = number("shutter opening");
+        const float t1 = number("shutter closing");
+        if (!(t0 <= t1)) fail(tok_.line(), "shutter closes before it opens" + where());
+        scene_.shutter_open = t0;
+        scene_.shutter_close = t1;
+        shutter_line_ = entity_line_;
+    }
+
+    /// Hit ids of a placement at the top, refused past 32 bits.
+    void count_top_ids(std::uint32_t object) {
+        top_instanced_ids_ += scene_.objects[object]->hit_id_count();
+        if (scene_.prims.size() + top_instanced_ids_ > kMaxHitIds - 1)
+            fail(entity_line_, "the scene holds more than 2^32 - 2 primitives with its instances expanded; "
+                               "hits are numbered in 32 bits");
+    }
+
+    /// A 3 x 4 row-major matrix of an `inst` line, checked.
+    Affine3f instance_matrix() {
+        Affine3f m;
+        for (auto& row : m.m)
+            for (float& x : row) x = number("instance matrix entry");
+        const double det = affine_cast<double>(m).determinant();
+        if (!std::isfinite(det) || std::fabs(det) < 1e-30)
+            fail(tok_.line(), "singular instance matrix (determinant " + std::to_string(det) + ")" + where());
+        const Affine3d inv = inverse(affine_cast<double>(m));
+        for (const auto& row : inv.m)
+            for (double x : row)
+                if (!std::isfinite(float(x))) fail(tok_.line(), "instance matrix has no finite inverse" + where());
+        return m;
+    }
 
     /// Lights are the scene's, not an object's: an instance would have to
     /// place them, and light sampling knows only the scene's own.
@@ -442,22 +519,43 @@ private:
         if (scene_.objects[k]->instance_depth() + 1 > kMaxInstanceDepth)
             fail(entity_line_, "placing " + quote_token(name) + " nests instances more than " +
                                    std::to_string(kMaxInstanceDepth) + " levels deep");
-        Affine3f m;
-        for (auto& row : m.m)
-            for (float& x : row) x = number("instance matrix entry");
-        const double det = affine_cast<double>(m).determinant();
-        if (!std::isfinite(det) || std::fabs(det) < 1e-30)
-            fail(tok_.line(), "singular instance matrix (determinant " + std::to_string(det) + ")" + where());
-        const Affine3d inv = inverse(affine_cast<double>(m));
-        for (const auto& row : inv.m)
-            for (double x : row)
-                if (!std::isfinite(float(x))) fail(tok_.line(), "instance matrix has no finite inverse" + where());
-        target().add_instance(k, m, scene_);
-        if (!defining_) {
-            top_instanced_ids_ += scene_.objects[k]->hit_id_count();
-            if (scene_.prims.size() + top_instanced_ids_ > kMaxHitIds - 1)
-                fail(entity_line_, "the scene holds more than 2^32 - 2 primitives with its instances expanded; "
-                                   "hits are numbered in 32 bits");
+        const Affine3f m = instance_matrix();
+        // A second matrix: where the placement is at the shutter's closing.
+        float x;
+        const bool two = parse_float_token(tok_.peek(), x) != NumberToken::NotNumber;
+        Affine3f end = two ? instance_matrix() : m;
+        if (defining_) {
+            if (two)
+                fail(entity_line_, "a moving placement inside object " + quote_token(defining_name_) +
+                                       ": objects are static (move their placements instead)");
+            defining_->add_instance(k, m, scene_);
+            return;
+        }
+        end.m[0][3] += move_.x, end.m[1][3] += move_.y, end.m[2][3] += move_.z;
+        if (end == m) {
+            scene_.add_instance(k, m, scene_);
+        } else {
+            refuse_singular_motion(m, end);
+            scene_.add_moving_instance(k, m, end, scene_);
+        }
+        count_top_ids(k);
+    }
+
+    /// The matrices are interpolated entry by entry, which can pass through a
+    /// singular matrix (a half turn does, at mid-shutter): the determinant,
+    /// a cubic in s, keeps its sign and stays away from 0 at 65 points.
+    void refuse_singular_motion(const Affine3f& a, const Affine3f& b) {
+        const double det0 = affine_cast<double>(a).determinant();
+        for (int i = 1; i <= 64; ++i) {
+            const double s = double(i) / 64.0;
+            Affine3d m;
+            for (int r = 0; r < 3; ++r)
+                for (int c = 0; c < 4; ++c) m.m[r][c] = (1.0 - s) * double(a.m[r][c]) + s * double(b.m[r][c]);
+            const double det = m.determinant();
+            if (!(det * det0 > 0) || std::fabs(det) < 1e-30)
+                fail(entity_line_, "the placement passes through a singular matrix at shutter fraction " +
+                                       std::to_string(s) + " (the two matrices are interpolated entry by entry)" +
+                                       where());
         }
     }
 
@@ -553,6 +651,10 @@ private:
     std::string defining_name_;
     int defining_line_ = 0;
     std::uint64_t top_instanced_ids_ = 0;  ///< hit ids of the scene's instances so far
+    Vec3f move_{};                         ///< the `move` in force
+    int move_line_ = 0;
+    std::shared_ptr<Scene> moving_group_;  ///< primitives under the `move` in force, if any
+    int shutter_line_ = 0;
     std::unordered_map<std::string, std::uint32_t> object_index_;  ///< name -> Scene::objects index
 };
 

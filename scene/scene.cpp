@@ -80,6 +80,35 @@ std::uint32_t Scene::add_instance(std::uint32_t object, const Affine3f& to_world
     return std::uint32_t(prims.size() - 1);
 }
 
+Affine3f Instance::to_world_at(float s) const {
+    // (1 - s) a + s b: exactly to_world at 0 and to_world_end at 1.
+    Affine3f r;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 4; ++j) r.m[i][j] = (1.0f - s) * to_world.m[i][j] + s * to_world_end.m[i][j];
+    return r;
+}
+
+Affine3f Instance::to_object_at(float s) const {
+    if (s == 0.0f) return to_object;
+    return affine_cast<float>(inverse(affine_cast<double>(to_world_at(s))));
+}
+
+std::uint32_t Scene::add_moving_instance(std::uint32_t object, const Affine3f& to_world, const Affine3f& to_world_end,
+                                         const Scene& top) {
+    Instance inst;
+    inst.object = object;
+    inst.to_world = to_world;
+    inst.to_object = affine_cast<float>(inverse(affine_cast<double>(to_world)));
+    inst.to_world_end = to_world_end;
+    const Box3f object_box = scene_bounds(*top.objects[object]);
+    inst.bounds_start = transform_box(to_world, object_box);
+    inst.bounds_end = transform_box(to_world_end, object_box);
+    inst.bounds = inst.bounds_start;
+    inst.bounds.extend(inst.bounds_end);
+    moving_instances.push_back(inst);
+    return std::uint32_t(moving_instances.size() - 1);
+}
+
 void Scene::update_features(const Scene* top) {
     if (top == nullptr) top = this;
     const auto& top_materials = top->materials;
@@ -104,13 +133,15 @@ void Scene::update_features(const Scene* top) {
     f.area_lights = !area_lights.empty();
     f.distant_lights = !distant_lights.empty();
     f.thin_lens = camera.lens_radius > 0;
-    f.instances = !instances.empty();
+    f.instances = placements();
+    f.motion = !moving_instances.empty();
     // Ids of instanced hits follow the scene's own primitives, instance by
-    // instance (Scene::hit_id_count); objects report what they contain.
+    // instance, the moving ones last (Scene::hit_id_count); objects report
+    // what they contain.
     hit_ids_ = prims.size();
     instanced_prims_ = prims.size() - instances.size();
     instance_depth_ = 0;
-    for (Instance& inst : instances) {
+    const auto place = [&](Instance& inst) {
         const Scene& o = *top->objects[inst.object];
         inst.first_hit_id = std::uint32_t(std::min<std::uint64_t>(hit_ids_, kMaxHitIds));
         hit_ids_ += o.hit_id_count();
@@ -121,7 +152,9 @@ void Scene::update_features(const Scene* top) {
         f.height_fields |= g.height_fields, f.instances |= g.instances;
         f.vertex_normals |= g.vertex_normals, f.inside_only |= g.inside_only;
         f.reflection |= g.reflection, f.transmission |= g.transmission, f.glossy |= g.glossy;
-    }
+    };
+    for (Instance& inst : instances) place(inst);
+    for (Instance& inst : moving_instances) place(inst);
     features = f;
 }
 
@@ -177,24 +210,44 @@ Box3f primitive_bounds(const Scene& s, std::uint32_t prim) {
 Box3f scene_bounds(const Scene& s) {
     Box3f b;
     for (std::uint32_t i = 0; i < s.prims.size(); ++i) b.extend(primitive_bounds(s, i));
+    for (const Instance& inst : s.moving_instances) b.extend(inst.bounds);
     return b;
 }
 
 const Instance& instance_of_hit_id(const Scene& scene, std::uint32_t id) {
-    // The last instance whose ids start at or before id.
-    const auto it = std::upper_bound(scene.instances.begin(), scene.instances.end(), id,
+    // The last instance whose ids start at or before id; moving instances'
+    // ids follow the static ones'.
+    const bool moving = !scene.moving_instances.empty() && id >= scene.moving_instances.front().first_hit_id;
+    const std::vector<Instance>& list = moving ? scene.moving_instances : scene.instances;
+    const auto it = std::upper_bound(list.begin(), list.end(), id,
                                      [](std::uint32_t x, const Instance& k) { return x < k.first_hit_id; });
     return *(it - 1);
 }
 
-ResolvedHit resolve_hit_id(const Scene& top, std::uint32_t id) {
+HitInPlacement hit_in_placement(const Scene& scene, const Rayf& ray, const Hitf& hit, float time) {
+    const Instance& inst = instance_of_hit_id(scene, hit.prim);
+    Hitf h = hit;
+    h.prim -= inst.first_hit_id;
+    HitInPlacement in{&inst, inst.to_world, inst.to_object, {}, h};
+    if (!scene.moving_instances.empty() && &inst >= scene.moving_instances.data() &&
+        &inst < scene.moving_instances.data() + scene.moving_instances.size()) {
+        const float s = scene.shutter_fraction(time);
+        in.to_world = inst.to_world_at(s);
+        in.to_object = inst.to_object_at(s);
+    }
+    in.ray = ray_in_object(in.to_object, ray);
+    return in;
+}
+
+ResolvedHit resolve_hit_id(const Scene& top, std::uint32_t id, float time) {
     ResolvedHit r;
     const Scene* s = &top;
-    while (id >= s->prims.size() && !s->instances.empty()) {
-        const Instance& inst = instance_of_hit_id(*s, id);
+    while (id >= s->prims.size() && s->placements()) {
+        const HitInPlacement in = hit_in_placement(*s, Rayf{}, Hitf{0, id}, time);
+        const Instance& inst = *in.instance;
         id -= inst.first_hit_id;
-        r.to_world = r.instanced ? compose(r.to_world, inst.to_world) : inst.to_world;
-        r.to_object = r.instanced ? compose(inst.to_object, r.to_object) : inst.to_object;
+        r.to_world = r.instanced ? compose(r.to_world, in.to_world) : in.to_world;
+        r.to_object = r.instanced ? compose(in.to_object, r.to_object) : in.to_object;
         r.instanced = true;
         s = top.objects[inst.object].get();
     }

@@ -2,6 +2,7 @@
 // The scene as structure of arrays: one set of arrays per primitive kind,
 // plus a global numbering of primitives in the order the file defines them.
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -117,8 +118,20 @@ struct ConeSoA {
 struct Instance {
     std::uint32_t object = 0;
     Affine3f to_world, to_object;  ///< to_object is the inverse of to_world
-    Box3f bounds;                  ///< world bounds of the placed object
+    Box3f bounds;                  ///< world bounds of the placed object (over the whole shutter if it moves)
     std::uint32_t first_hit_id = 0;
+    /// Motion (Scene::moving_instances only): the object sits at
+    /// (1 - s) to_world + s to_world_end at shutter fraction s, the matrices
+    /// interpolated entry by entry as Embree interpolates an instance's
+    /// time steps. Every point then moves on a straight line, so the box at
+    /// s lies within the same interpolation of the boxes at 0 and 1.
+    Affine3f to_world_end;
+    Box3f bounds_start, bounds_end;
+
+    /// The placement at shutter fraction s in [0, 1] (moving instances).
+    Affine3f to_world_at(float s) const;
+    /// Its inverse, computed in double like to_object.
+    Affine3f to_object_at(float s) const;
 };
 
 /// What a scene uses, so that the hot loops can skip what it does not.
@@ -128,6 +141,7 @@ struct Features {
     bool cones = false;
     bool height_fields = false;
     bool instances = false;
+    bool motion = false;        ///< moving placements (NFF `move`, two-matrix `inst`)
     bool vertex_normals = false;
     bool reflection = false;    ///< some material has Ks > 0
     bool transmission = false;  ///< some material has T > 0
@@ -162,6 +176,24 @@ struct Scene {
     /// instances index the top scene's list. Materials are the top scene's.
     std::vector<std::shared_ptr<const Scene>> objects;
     std::vector<std::string> object_names;
+    /// NFF extensions `move` and two-matrix `inst`: placements that move over
+    /// the shutter. Not primitives (no entry in `prims`): the structures over
+    /// `prims` stay static, and build_accel puts these in a motion BVH
+    /// (accel/motion/motion_bvh.h). Their hit ids follow the static
+    /// instances'. Only the top scene moves: objects are static.
+    std::vector<Instance> moving_instances;
+    /// NFF extension `shutter t0 t1`: the times rays may carry (ray time t
+    /// is shutter fraction (t - t0) / (t1 - t0), clamped to [0, 1]).
+    float shutter_open = 0, shutter_close = 1;
+    /// Shutter fraction of scene time `time`: 0 at or before the opening
+    /// (also for -inf, "no time", and NaN), 1 at or after the closing, and 0
+    /// for a shutter of no length (t0 = t1 freezes every motion at t0).
+    float shutter_fraction(float time) const {
+        const float length = shutter_close - shutter_open;
+        if (!(length > 0) || !(time > shutter_open)) return 0.0f;
+        const float s = (time - shutter_open) / length;
+        return s < 1.0f ? s : 1.0f;
+    }
 
     std::vector<PrimRef> prims;                ///< global number -> kind, index
     std::vector<std::uint32_t> prim_material;  ///< global number -> materials[]
@@ -174,13 +206,15 @@ struct Scene {
     /// hit), and instance k's hits are first_hit_id + the id inside its
     /// object, which past the object's own primitives recurses the same way.
     /// Without instances it is primitive_count().
-    std::uint64_t hit_id_count() const { return instances.empty() ? prims.size() : hit_ids_; }
+    std::uint64_t hit_id_count() const { return placements() ? hit_ids_ : prims.size(); }
     /// Primitives once every instance is expanded (instances themselves not
     /// counted): what the scene would hold flattened.
-    std::uint64_t instanced_primitive_count() const { return instances.empty() ? prims.size() : instanced_prims_; }
+    std::uint64_t instanced_primitive_count() const { return placements() ? instanced_prims_ : prims.size(); }
     /// Levels of placements below this scene: 0 without instances, else 1 +
     /// the deepest placed object's.
-    int instance_depth() const { return instances.empty() ? 0 : instance_depth_; }
+    int instance_depth() const { return placements() ? instance_depth_ : 0; }
+    /// Whether the scene places objects (static or moving).
+    bool placements() const { return !instances.empty() || !moving_instances.empty(); }
     /// Lights of every kind: the L of the SPD intensity rule.
     std::size_t light_count() const { return lights.size() + area_lights.size() + distant_lights.size(); }
     /// SPD Readme: each light (and the ambient term) gets sqrt(L) / (2 L).
@@ -199,6 +233,12 @@ struct Scene {
     /// invertible (the loader checks); `top` holds the objects (it may be
     /// this scene). Call update_features before tracing: it numbers the hit ids.
     std::uint32_t add_instance(std::uint32_t object, const Affine3f& to_world, const Scene& top);
+    /// A placement moving from `to_world` at the shutter's opening to
+    /// `to_world_end` at its closing; both finite, and every interpolation
+    /// between them invertible (the loader checks). Returns its index in
+    /// moving_instances.
+    std::uint32_t add_moving_instance(std::uint32_t object, const Affine3f& to_world, const Affine3f& to_world_end,
+                                      const Scene& top);
     /// Room for `more` triangles, so that a loader that knows how many
     /// follow does not grow the arrays by copying (fresh pages cost more
     /// than the copies on the measured machines).
@@ -232,30 +272,30 @@ struct ResolvedHit {
     Affine3f to_world, to_object;
     bool instanced = false;
 };
-ResolvedHit resolve_hit_id(const Scene& top, std::uint32_t id);
+ResolvedHit resolve_hit_id(const Scene& top, std::uint32_t id, float time = -std::numeric_limits<float>::infinity());
 
-/// The instance of `scene` whose hit ids hold `id` (id >= prims.size()).
+/// The instance of `scene` (static or moving) whose hit ids hold `id` (id >= prims.size()).
 const Instance& instance_of_hit_id(const Scene& scene, std::uint32_t id);
 
 /// A ray in an instance's object space, as the traversal takes it there
 /// (the direction not renormalised, so t is unchanged).
-inline Rayf ray_in_object(const Instance& inst, const Rayf& ray) {
-    return {inst.to_object.point(ray.org), inst.to_object.vector(ray.dir), ray.tnear, ray.tfar};
+inline Rayf ray_in_object(const Affine3f& to_object, const Rayf& ray) {
+    return {to_object.point(ray.org), to_object.vector(ray.dir), ray.tnear, ray.tfar};
 }
+inline Rayf ray_in_object(const Instance& inst, const Rayf& ray) { return ray_in_object(inst.to_object, ray); }
 
 /// A hit inside one of `scene`'s placements, one level down: the
-/// placement, the ray in its object's space and the hit with its id there.
+/// placement (where it is at the ray's time), the ray in its object's
+/// space and the hit with its id there. `time` is scene time (-inf: the
+/// shutter's opening); only moving placements depend on it.
 struct HitInPlacement {
     const Instance* instance;
+    Affine3f to_world, to_object;
     Rayf ray;
     Hitf hit;
 };
-inline HitInPlacement hit_in_placement(const Scene& scene, const Rayf& ray, const Hitf& hit) {
-    const Instance& inst = instance_of_hit_id(scene, hit.prim);
-    Hitf h = hit;
-    h.prim -= inst.first_hit_id;
-    return {&inst, ray_in_object(inst, ray), h};
-}
+HitInPlacement hit_in_placement(const Scene& scene, const Rayf& ray, const Hitf& hit,
+                                float time = -std::numeric_limits<float>::infinity());
 
 /// Bounds of one primitive and of the whole scene.
 Box3f primitive_bounds(const Scene& scene, std::uint32_t prim);

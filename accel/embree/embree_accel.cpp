@@ -286,7 +286,7 @@ void EmbreeAccel::build(const Scene& scene, const EmbreeOptions& options) {
     if ((scene.spheres.size() && !rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_POINT_GEOMETRY_SUPPORTED)) ||
         (scene.cones.size() && !rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_USER_GEOMETRY_SUPPORTED)))
         fail("this build lacks point or user geometry");
-    if (!scene.instances.empty())
+    if (scene.placements())
         fail("the scene has instances, which the Embree backend does not trace (raypack's own structures do)");
     if (!scene.height_fields.empty())
         fail("the scene has height fields, which the Embree backend does not trace (raypack's own structures do)");

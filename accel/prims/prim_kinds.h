@@ -78,7 +78,7 @@ using TriangleKinds = KindList<TrianglePrims>;
 /// unless `--specialise off`.
 inline KindSpecialisation specialisation_for(const Scene& scene, const KernelChoice& k) {
     const bool triangles_only = scene.triangles.size() > 0 && scene.spheres.size() == 0 && scene.cones.size() == 0 &&
-                                scene.height_fields.empty() && scene.instances.empty();
+                                scene.height_fields.empty() && !scene.placements();
     const bool default_kernels = k.triangle == TriangleMethod::Moeller && k.precision == Precision::Float;
     return k.specialise && triangles_only && default_kernels ? KindSpecialisation::Triangles
                                                              : KindSpecialisation::General;

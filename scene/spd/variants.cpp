@@ -1,7 +1,10 @@
 #include "scene/spd/variants.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <numbers>
 #include <sstream>
 #include <stdexcept>
 
@@ -15,6 +18,7 @@ std::optional<SceneVariants> parse_scene_variants(std::string_view names) {
         if (name == "area-lights") v.area_lights = true;
         else if (name == "lens") v.lens = true;
         else if (name == "glossy") v.glossy = true;
+        else if (name == "motion") v.motion = true;
         else return std::nullopt;
         names = plus == std::string_view::npos ? std::string_view{} : names.substr(plus + 1);
     }
@@ -50,7 +54,8 @@ std::string apply_scene_variants(const std::string& nff, const SceneVariants& va
                   (from[2] - at[2]) * (from[2] - at[2]));
     std::string out;
     std::istringstream again(nff);
-    bool gloss_written = false;
+    bool gloss_written = false, moving = false;
+    std::uint64_t spheres = 0;
     while (std::getline(again, line)) {
         std::istringstream words(line);
         std::string key;
@@ -63,6 +68,26 @@ std::string apply_scene_variants(const std::string& nff, const SceneVariants& va
             out += "ls " + number(x) + " " + number(y) + " " + number(z) + " " + number(0.05 * distance) + rest + "\n";
             continue;
         }
+        if (variants.motion && key == "s") {
+            double x, y, z, r;
+            if (words >> x >> y >> z >> r) {
+                // A direction of the sphere's own from its number (a hash to
+                // two angles), the same on every run.
+                std::uint64_t h = (++spheres) * 0x9E3779B97F4A7C15ull;
+                h ^= h >> 31;
+                h *= 0xBF58476D1CE4E5B9ull;
+                h ^= h >> 29;
+                const double u = double(h >> 40) / double(1ull << 24), w = double(h & 0xFFFFFF) / double(1 << 24);
+                const double cz = 2 * u - 1, sz = std::sqrt(std::max(0.0, 1 - cz * cz)), phi = 2 * std::numbers::pi * w;
+                const double len = 1.5 * std::fabs(r);
+                out += "move " + number(len * sz * std::cos(phi)) + " " + number(len * sz * std::sin(phi)) + " " +
+                       number(len * cz) + "\n";
+                moving = true;
+            }
+        } else if (moving && key != "f" && !key.empty() && key[0] != '#') {
+            out += "move 0 0 0\n";
+            moving = false;
+        }
         if (variants.glossy && key == "f" && !gloss_written) {
             out += "gloss 40\n";
             gloss_written = true;
@@ -71,6 +96,7 @@ std::string apply_scene_variants(const std::string& nff, const SceneVariants& va
         if (variants.lens && key == "resolution")  // the end of the viewpoint block
             out += "lens " + number(0.02 * distance) + " " + number(distance) + "\n";
     }
+    if (moving) out += "move 0 0 0\n";
     return out;
 }
 

@@ -1,0 +1,238 @@
+#include "accel/motion/motion_bvh.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "accel/accel.h"
+#include "kernels/aabb.h"
+
+namespace raypack {
+
+namespace {
+
+/// Binned SAH (Wald 2007) over the placements' boxes at mid-shutter
+/// centroids; the cost of a subtree's box is the mean of its half areas at
+/// the shutter's two ends (Embree's builder for linear bounds does the same).
+constexpr int kBins = 16;
+constexpr std::uint32_t kMaxLeaf = 4;
+/// Entering a placement (a matrix inverse, a transformed ray and a traversal
+/// of its object) costs several node tests.
+constexpr float kPlacementCost = 4.0f;
+/// Past this depth, splits are at the median (so that the depth stays
+/// bounded whatever the boxes); the walk's stack holds kStack nodes.
+constexpr int kMedianDepth = 48;
+constexpr int kStack = 128;
+
+Vec3f centroid(const Instance& inst) { return (inst.bounds_start.center() + inst.bounds_end.center()) * 0.5f; }
+
+float motion_cost(const Box3f& start, const Box3f& end) { return 0.5f * (start.half_area() + end.half_area()); }
+
+}  // namespace
+
+Box3f interpolate_box(const Box3f& a, const Box3f& b, float s) {
+    Box3f r;
+    for (int k = 0; k < 3; ++k) {
+        const float lo = (1.0f - s) * a.lo[k] + s * b.lo[k];
+        const float hi = (1.0f - s) * a.hi[k] + s * b.hi[k];
+        // Each of the two products and the sum rounds once: 4e-7 of the
+        // magnitudes is over three ULPs of either.
+        const float pad_lo = (std::fabs(a.lo[k]) + std::fabs(b.lo[k])) * 4e-7f;
+        const float pad_hi = (std::fabs(a.hi[k]) + std::fabs(b.hi[k])) * 4e-7f;
+        r.lo[k] = lo - pad_lo;
+        r.hi[k] = hi + pad_hi;
+    }
+    return r;
+}
+
+MotionBvh::MotionBvh(const Scene& scene, const ObjectAccels& objects, bool brute)
+    : scene_(scene), objects_(objects), brute_(brute) {
+    const auto n = std::uint32_t(scene.moving_instances.size());
+    order_.resize(n);
+    for (std::uint32_t k = 0; k < n; ++k) order_[k] = k;
+    if (brute_ || n == 0) return;
+    nodes_.reserve(2 * std::size_t(n));
+    nodes_.emplace_back();
+    build(0, 0, n, 1);
+}
+
+void MotionBvh::build(std::uint32_t node, std::uint32_t begin, std::uint32_t end, int depth) {
+    depth_ = std::max(depth_, depth);
+    const auto& insts = scene_.moving_instances;
+    Box3f start, endb, centres;
+    for (std::uint32_t i = begin; i < end; ++i) {
+        const Instance& inst = insts[order_[i]];
+        start.extend(inst.bounds_start);
+        endb.extend(inst.bounds_end);
+        centres.extend(centroid(inst));
+    }
+    nodes_[node].start = start;
+    nodes_[node].end = endb;
+    const std::uint32_t count = end - begin;
+    const auto make_leaf = [&] {
+        nodes_[node].first = begin;
+        nodes_[node].count = count;
+    };
+    if (count == 1) return make_leaf();
+    const Vec3f ext = centres.extent();
+    const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
+    const auto key = [&](std::uint32_t k) { return centroid(insts[k])[axis]; };
+    std::uint32_t mid = begin;
+    if (depth < kMedianDepth && ext[axis] > 0) {
+        struct Bin {
+            Box3f start, end;
+            std::uint32_t count = 0;
+        };
+        std::array<Bin, kBins> bins{};
+        const float scale = float(kBins) / ext[axis];
+        const auto bin_of = [&](std::uint32_t k) {
+            return std::min(kBins - 1, std::max(0, int((key(k) - centres.lo[axis]) * scale)));
+        };
+        for (std::uint32_t i = begin; i < end; ++i) {
+            Bin& b = bins[std::size_t(bin_of(order_[i]))];
+            const Instance& inst = insts[order_[i]];
+            b.start.extend(inst.bounds_start);
+            b.end.extend(inst.bounds_end);
+            ++b.count;
+        }
+        // Costs of the right side of each plane, then the sweep from the left.
+        std::array<float, kBins> right_cost{};
+        std::array<std::uint32_t, kBins> right_count{};
+        Box3f rs, re;
+        std::uint32_t rc = 0;
+        for (int b = kBins - 1; b > 0; --b) {
+            rs.extend(bins[std::size_t(b)].start);
+            re.extend(bins[std::size_t(b)].end);
+            rc += bins[std::size_t(b)].count;
+            right_cost[std::size_t(b)] = motion_cost(rs, re);
+            right_count[std::size_t(b)] = rc;
+        }
+        Box3f ls, le;
+        std::uint32_t lc = 0;
+        float best = INFINITY;
+        int best_bin = -1;
+        for (int b = 1; b < kBins; ++b) {
+            ls.extend(bins[std::size_t(b - 1)].start);
+            le.extend(bins[std::size_t(b - 1)].end);
+            lc += bins[std::size_t(b - 1)].count;
+            if (lc == 0 || right_count[std::size_t(b)] == 0) continue;
+            const float cost =
+                motion_cost(ls, le) * float(lc) + right_cost[std::size_t(b)] * float(right_count[std::size_t(b)]);
+            if (cost < best) best = cost, best_bin = b;
+        }
+        if (best_bin >= 0) {
+            const float parent = motion_cost(start, endb);
+            const float split_cost = parent > 0 ? 1.0f + kPlacementCost * best / parent : INFINITY;
+            if (count <= kMaxLeaf && kPlacementCost * float(count) <= split_cost) return make_leaf();
+            mid = std::uint32_t(std::partition(order_.begin() + begin, order_.begin() + end,
+                                               [&](std::uint32_t k) { return bin_of(k) < best_bin; }) -
+                                order_.begin());
+        }
+    }
+    if (mid == begin || mid == end) {
+        // No SAH split (every centre in one point, or too deep): the median
+        // along the widest axis, which keeps the depth logarithmic.
+        if (!(ext[axis] > 0) && count <= kMaxLeaf) return make_leaf();
+        mid = begin + count / 2;
+        std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end,
+                         [&](std::uint32_t a, std::uint32_t b) { return key(a) < key(b); });
+    }
+    const auto left = std::uint32_t(nodes_.size());
+    nodes_.emplace_back();
+    nodes_.emplace_back();
+    nodes_[node].first = left;
+    nodes_[node].count = 0;
+    build(left, begin, mid, depth + 1);
+    build(left + 1, mid, end, depth + 1);
+}
+
+template <bool AnyHit>
+bool MotionBvh::test_placement(std::uint32_t k, const Rayf& ray, const Vec3f& inv_dir, float s, Hitf& hit) const {
+    const Instance& inst = scene_.moving_instances[k];
+    const float tfar = hit.found() ? std::min(ray.tfar, hit.t) : ray.tfar;
+    if (!brute_) {
+        float entry;
+        if (!intersect_aabb(ray.org, inv_dir, interpolate_box(inst.bounds_start, inst.bounds_end, s), ray.tnear, tfar,
+                            entry))
+            return false;
+    }
+    Rayf r = ray_in_object(inst.to_object_at(s), ray);
+    r.tfar = tfar;
+    const Accel& object = *objects_.accels[inst.object];
+    if constexpr (AnyHit) {
+        return object.occluded1(r);
+    } else {
+        const Hitf h = object.intersect1(r);
+        if (!h.found() || (hit.found() && !(h.t < hit.t))) return false;
+        hit = h;
+        hit.prim = inst.first_hit_id + h.prim;
+        return true;
+    }
+}
+
+template <bool AnyHit>
+bool MotionBvh::walk(const Rayf& ray, float s, Hitf& hit) const {
+    const Vec3f inv_dir = reciprocal(ray.dir);
+    bool found = false;
+    if (brute_) {
+        for (std::uint32_t k = 0; k < order_.size(); ++k) {
+            if (!test_placement<AnyHit>(k, ray, inv_dir, s, hit)) continue;
+            if constexpr (AnyHit) return true;
+            found = true;
+        }
+        return found;
+    }
+    if (nodes_.empty()) return false;
+    // Boxes are tested when their parent is visited; the stack keeps each
+    // node's entry distance, so that one farther than a hit found since is
+    // dropped.
+    struct Entry {
+        std::uint32_t node;
+        float entry;
+    };
+    Entry stack[kStack];
+    int top = 0;
+    const auto meets = [&](const Node& n, float tfar, float& entry) {
+        return intersect_aabb(ray.org, inv_dir, interpolate_box(n.start, n.end, s), ray.tnear, tfar, entry);
+    };
+    float root_entry;
+    if (!meets(nodes_[0], ray.tfar, root_entry)) return false;
+    stack[top++] = {0, root_entry};
+    while (top > 0) {
+        const Entry e = stack[--top];
+        const float tfar = hit.found() ? std::min(ray.tfar, hit.t) : ray.tfar;
+        if (e.entry > tfar) continue;
+        const Node& node = nodes_[e.node];
+        if (node.count > 0) {
+            for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
+                if (!test_placement<AnyHit>(order_[i], ray, inv_dir, s, hit)) continue;
+                if constexpr (AnyHit) return true;
+                found = true;
+            }
+            continue;
+        }
+        // The nearer child is pushed last, so visited first.
+        float ea = INFINITY, eb = INFINITY;
+        const bool ha = meets(nodes_[node.first], tfar, ea);
+        const bool hb = meets(nodes_[node.first + 1], tfar, eb);
+        if (ha && hb) {
+            const bool a_first = ea <= eb;
+            stack[top++] = a_first ? Entry{node.first + 1, eb} : Entry{node.first, ea};
+            stack[top++] = a_first ? Entry{node.first, ea} : Entry{node.first + 1, eb};
+        } else if (ha) {
+            stack[top++] = {node.first, ea};
+        } else if (hb) {
+            stack[top++] = {node.first + 1, eb};
+        }
+    }
+    return found;
+}
+
+void MotionBvh::intersect(const Rayf& ray, float s, Hitf& hit) const { walk<false>(ray, s, hit); }
+
+bool MotionBvh::occluded(const Rayf& ray, float s) const {
+    Hitf none;
+    return walk<true>(ray, s, none);
+}
+
+}  // namespace raypack
