@@ -135,7 +135,7 @@ std::unique_ptr<Accel> build_accel(const Scene& scene, const AccelConfig& config
     double motion_ms = 0;
     if (!scene.moving_instances.empty()) {
         const auto start = std::chrono::steady_clock::now();
-        motion = std::make_unique<MotionBvh>(scene, *objects, config.kind == "brute");
+        motion = std::make_unique<MotionBvh>(scene, *objects, config.kernels, config.kind == "brute");
         motion_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     }
     return std::make_unique<InstancedAccel>(scene, std::move(objects), std::move(top), std::move(motion), motion_ms);

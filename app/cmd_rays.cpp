@@ -25,6 +25,8 @@ int run_rays(const Args& args) {
             "  shadow   any-hit rays from each camera hit to the first light (kind 1): a point light,\n"
             "           else a distant one, else an area light's centre (a sphere's facing point)\n"
             "  diffuse  a cosine-weighted bounce from each camera hit (kind 0); --seed S (default 1)\n"
+            "A scene that moves (shutter, move) gives each pixel's rays a time over the shutter\n"
+            "(a version 2 file, docs/rays.md).\n"
             "%s",
             (offset_option_help() + scene_option_help()).c_str());
         if (!p.help()) throw UsageError("missing SCENE");
@@ -37,19 +39,21 @@ int run_rays(const Args& args) {
     const int w = int(p.integer("--res", scene.camera.width, 1, 16384, 0));
     const int h = int(p.integer("--res", scene.camera.height, 1, 16384, 1));
     std::vector<Rayf> rays;
+    std::vector<float> times;  // a scene that moves: one per ray (a version 2 file)
     RayKind file_kind = RayKind::ClosestHit;
     if (kind == "camera") {
-        rays = camera_ray_set(scene, w, h);
+        rays = camera_ray_set(scene, w, h, &times);
     } else if (kind == "shadow") {
-        rays = shadow_ray_set(scene, w, h, offset);
+        rays = shadow_ray_set(scene, w, h, offset, &times);
         file_kind = RayKind::AnyHit;
     } else if (kind == "diffuse") {
-        rays = diffuse_ray_set(scene, w, h, std::uint64_t(p.integer("--seed", 1, 0, 1LL << 62)), offset);
+        rays = diffuse_ray_set(scene, w, h, std::uint64_t(p.integer("--seed", 1, 0, 1LL << 62)), offset, &times);
     } else {
         throw UsageError("--kind: expected camera, shadow or diffuse, got '" + kind + "'");
     }
-    write_rays(p.text("--output"), file_kind, rays);
-    std::printf("wrote %zu %s rays to %s\n", rays.size(), kind.c_str(), p.text("--output").c_str());
+    write_rays(p.text("--output"), file_kind, rays, times);
+    std::printf("wrote %zu %s rays%s to %s\n", rays.size(), kind.c_str(),
+                times.empty() ? "" : " (with times over the shutter)", p.text("--output").c_str());
     return 0;
 }
 

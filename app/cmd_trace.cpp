@@ -28,11 +28,18 @@ double trace_all(const Accel& accel, int packet, const RayFile& file, std::vecto
         for (std::size_t b = r.begin(); b < r.end(); ++b) {
             const std::size_t lo = b * kBatch, hi = std::min(n, lo + kBatch);
             const std::span<const Rayf> rays(file.rays.data() + lo, hi - lo);
+            // Version 2 files: each ray at its time.
+            const std::span<const float> times =
+                file.times.empty() ? std::span<const float>{} : std::span<const float>(file.times.data() + lo, hi - lo);
             if (file.kind == RayKind::ClosestHit) {
-                accel.intersect_packets(packet, rays, std::span<Hitf>(hits.data() + lo, hi - lo));
+                const std::span<Hitf> out(hits.data() + lo, hi - lo);
+                if (times.empty()) accel.intersect_packets(packet, rays, out);
+                else accel.intersect_at(packet, rays, times, out);
             } else {
                 std::uint8_t occluded[kBatch];
-                accel.occluded_packets(packet, rays, std::span<std::uint8_t>(occluded, hi - lo));
+                const std::span<std::uint8_t> out(occluded, hi - lo);
+                if (times.empty()) accel.occluded_packets(packet, rays, out);
+                else accel.occluded_at(packet, rays, times, out);
                 for (std::size_t i = lo; i < hi; ++i) {
                     hits[i] = Hitf{};
                     if (occluded[i - lo]) hits[i].prim = 0;  // rays.md: 0 = occluded

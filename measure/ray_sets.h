@@ -9,13 +9,20 @@
 
 namespace raypack {
 
+// Scenes that move (Scene::moving_instances): with `times`, each set gives
+// every ray a scene time, one per pixel drawn uniformly over the shutter
+// (the same every run), and shadow and diffuse rays leave the surface their
+// camera ray met at that time; times->size() == the set's size. Without
+// `times` (or for a static scene) rays have no time: the shutter's opening.
+
 /// One ray through each pixel centre, row by row from the top.
-std::vector<Rayf> camera_ray_set(const Scene& scene, int width, int height);
+std::vector<Rayf> camera_ray_set(const Scene& scene, int width, int height, std::vector<float>* times = nullptr);
 
 /// From each camera-ray hit (found with the reference BVH2) toward the first
 /// light, offset off the surface by `offset`; tfar stops just short of the
 /// light. Empty when the scene has no light.
-std::vector<Rayf> shadow_ray_set(const Scene& scene, int width, int height, OffsetPolicy offset = kDefaultOffset);
+std::vector<Rayf> shadow_ray_set(const Scene& scene, int width, int height, OffsetPolicy offset = kDefaultOffset,
+                                 std::vector<float>* times = nullptr);
 
 /// From each camera-ray hit, one diffuse bounce: a cosine-weighted unit
 /// direction about the shading normal turned toward the incoming ray (Malley's
@@ -24,6 +31,6 @@ std::vector<Rayf> shadow_ray_set(const Scene& scene, int width, int height, Offs
 /// seeded by (seed, i), so the set is the same every run and for any thread
 /// count. Origins are offset off the surface as for shadow rays; tfar = inf.
 std::vector<Rayf> diffuse_ray_set(const Scene& scene, int width, int height, std::uint64_t seed = 1,
-                                  OffsetPolicy offset = kDefaultOffset);
+                                  OffsetPolicy offset = kDefaultOffset, std::vector<float>* times = nullptr);
 
 }  // namespace raypack

@@ -16,8 +16,13 @@ namespace {
 static_assert(std::endian::native == std::endian::little, "the exchange format is little-endian");
 
 constexpr char kRaysMagic[8] = {'R', 'A', 'Y', 'S', '0', '0', '0', '1'};
+/// Version 2: a ninth float per record, the ray's time.
+constexpr char kTimedRaysMagic[8] = {'R', 'A', 'Y', 'S', '0', '0', '0', '2'};
 constexpr char kHitsMagic[8] = {'H', 'I', 'T', 'S', '0', '0', '0', '1'};
-constexpr std::size_t kRayRecord = 32, kHitRecord = 16;
+constexpr std::size_t kRayRecord = 32, kTimedRayRecord = 36, kHitRecord = 16;
+
+/// Whether a rays file's first bytes are version 2's magic.
+bool timed_rays(std::string_view head) { return head.size() >= 8 && std::memcmp(head.data(), kTimedRaysMagic, 8) == 0; }
 
 [[noreturn]] void fail(const std::string& path, const std::string& what) {
     throw std::runtime_error(path + ": " + what);
@@ -62,7 +67,10 @@ std::string read_checked(const std::string& path, Check&& check) {
 }  // namespace
 
 RayFile parse_rays(std::string_view bytes, const std::string& name) {
-    const std::uint64_t count = checked_count(bytes, bytes.size(), name, kRaysMagic, 24, kRayRecord);
+    const bool timed = timed_rays(bytes);
+    const std::size_t record = timed ? kTimedRayRecord : kRayRecord;
+    const std::uint64_t count =
+        checked_count(bytes, bytes.size(), name, timed ? kTimedRaysMagic : kRaysMagic, 24, record);
     std::uint32_t kind = 0;
     std::memcpy(&kind, bytes.data() + 16, 4);
     if (kind > 1) fail(name, "unknown ray kind " + std::to_string(kind) + " (expected 0 or 1)");
@@ -70,10 +78,11 @@ RayFile parse_rays(std::string_view bytes, const std::string& name) {
     RayFile file;
     file.kind = RayKind(kind);
     file.rays.resize(count);
+    if (timed) file.times.resize(count);
     const char* rec = bytes.data() + 24;
-    for (std::uint64_t i = 0; i < count; ++i, rec += kRayRecord) {
-        float r[8];
-        std::memcpy(r, rec, sizeof r);
+    for (std::uint64_t i = 0; i < count; ++i, rec += record) {
+        float r[9];
+        std::memcpy(r, rec, record);
         Rayf& ray = file.rays[i];
         ray.org = {r[0], r[1], r[2]};
         ray.tnear = r[3];
@@ -81,6 +90,10 @@ RayFile parse_rays(std::string_view bytes, const std::string& name) {
         ray.tfar = r[7];
         if (!all_finite(ray.org) || !all_finite(ray.dir) || std::isnan(ray.tnear) || std::isnan(ray.tfar))
             fail(name, "ray " + std::to_string(i) + " has a non-finite origin, direction or NaN interval");
+        if (timed) {
+            if (!std::isfinite(r[8])) fail(name, "ray " + std::to_string(i) + " has a non-finite time");
+            file.times[i] = r[8];
+        }
     }
     return file;
 }
@@ -103,8 +116,10 @@ std::vector<Hitf> parse_hits(std::string_view bytes, const std::string& name) {
 RayFile read_rays(const std::string& path) {
     // The file's bytes and the rays, 32 bytes each per ray.
     const std::string bytes = read_checked(path, [&](std::string_view head, std::uint64_t size) {
-        const std::uint64_t count = checked_count(head, size, path, kRaysMagic, 24, kRayRecord);
-        require_memory(count * 64, path + ": " + std::to_string(count) + " rays");
+        const bool timed = timed_rays(head);
+        const std::uint64_t count = checked_count(head, size, path, timed ? kTimedRaysMagic : kRaysMagic, 24,
+                                                  timed ? kTimedRayRecord : kRayRecord);
+        require_memory(count * 72, path + ": " + std::to_string(count) + " rays");
     });
     return parse_rays(bytes, path);
 }
@@ -117,19 +132,24 @@ std::vector<Hitf> read_hits(const std::string& path) {
     return parse_hits(bytes, path);
 }
 
-void write_rays(const std::string& path, RayKind kind, std::span<const Rayf> rays) {
+void write_rays(const std::string& path, RayKind kind, std::span<const Rayf> rays, std::span<const float> times) {
+    if (!times.empty() && times.size() != rays.size())
+        throw std::invalid_argument(path + ": " + std::to_string(times.size()) + " times for " +
+                                    std::to_string(rays.size()) + " rays");
     write_atomically(path, [&](const std::string& tmp) {
         std::ofstream out(tmp, std::ios::binary);
         if (!out) fail(path, "cannot open for writing");
         const std::uint64_t count = rays.size();
         const std::uint32_t k = std::uint32_t(kind), reserved = 0;
-        out.write(kRaysMagic, 8);
+        out.write(times.empty() ? kRaysMagic : kTimedRaysMagic, 8);
         out.write(reinterpret_cast<const char*>(&count), 8);
         out.write(reinterpret_cast<const char*>(&k), 4);
         out.write(reinterpret_cast<const char*>(&reserved), 4);
-        for (const Rayf& r : rays) {
-            const float rec[8] = {r.org.x, r.org.y, r.org.z, r.tnear, r.dir.x, r.dir.y, r.dir.z, r.tfar};
-            out.write(reinterpret_cast<const char*>(rec), sizeof rec);
+        for (std::size_t i = 0; i < rays.size(); ++i) {
+            const Rayf& r = rays[i];
+            const float rec[9] = {r.org.x, r.org.y, r.org.z, r.tnear, r.dir.x, r.dir.y, r.dir.z, r.tfar,
+                                  times.empty() ? 0.0f : times[i]};
+            out.write(reinterpret_cast<const char*>(rec), std::streamsize(times.empty() ? kRayRecord : kTimedRayRecord));
         }
         if (!out.flush()) fail(path, "write failed");
     });

@@ -90,6 +90,15 @@ Affine3f Instance::to_world_at(float s) const {
 
 Affine3f Instance::to_object_at(float s) const {
     if (s == 0.0f) return to_object;
+    if (translates_only) {
+        // p = A q + b(s)  =>  q = A^-1 p - A^-1 b(s).
+        Affine3f r = to_object;
+        Vec3f b;
+        for (int i = 0; i < 3; ++i) b[i] = (1.0f - s) * to_world.m[i][3] + s * to_world_end.m[i][3];
+        const Vec3f t = to_object.vector(b);
+        r.m[0][3] = -t.x, r.m[1][3] = -t.y, r.m[2][3] = -t.z;
+        return r;
+    }
     return affine_cast<float>(inverse(affine_cast<double>(to_world_at(s))));
 }
 
@@ -100,6 +109,9 @@ std::uint32_t Scene::add_moving_instance(std::uint32_t object, const Affine3f& t
     inst.to_world = to_world;
     inst.to_object = affine_cast<float>(inverse(affine_cast<double>(to_world)));
     inst.to_world_end = to_world_end;
+    inst.translates_only = true;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) inst.translates_only &= to_world.m[i][j] == to_world_end.m[i][j];
     const Box3f object_box = scene_bounds(*top.objects[object]);
     inst.bounds_start = transform_box(to_world, object_box);
     inst.bounds_end = transform_box(to_world_end, object_box);

@@ -127,6 +127,9 @@ struct Instance {
     /// s lies within the same interpolation of the boxes at 0 and 1.
     Affine3f to_world_end;
     Box3f bounds_start, bounds_end;
+    /// The linear parts at both ends are the same (a `move`): in between
+    /// the inverse is to_object's linear part with a new translation.
+    bool translates_only = false;
 
     /// The placement at shutter fraction s in [0, 1] (moving instances).
     Affine3f to_world_at(float s) const;

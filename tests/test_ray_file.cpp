@@ -132,6 +132,37 @@ TEST_F(RayFile, RaysRoundTripBitExact) {
     EXPECT_EQ(rec[6], 1.0f);
 }
 
+// Version 2 (motion blur): a time after each record; version 1 files still
+// read, with no times; a non-finite time is refused.
+TEST_F(RayFile, TimedRaysRoundTripAsVersion2) {
+    const std::vector<Rayf> rays = sample_rays();
+    std::vector<float> times(rays.size());
+    for (std::size_t i = 0; i < times.size(); ++i) times[i] = 0.25f * float(i) - 3.0f;
+    write_rays(path("t.rays"), RayKind::AnyHit, rays, times);
+    EXPECT_EQ(fs::file_size(path("t.rays")), 24 + 36 * rays.size());
+    const std::string bytes = slurp(path("t.rays"));
+    EXPECT_EQ(bytes.substr(0, 8), "RAYS0002");
+    float rec[9];
+    std::memcpy(rec, bytes.data() + 24 + 36, 36);
+    EXPECT_EQ(rec[0], rays[1].org.x);
+    EXPECT_EQ(rec[8], times[1]);
+    const raypack::RayFile back = read_rays(path("t.rays"));
+    EXPECT_EQ(back.kind, RayKind::AnyHit);
+    ASSERT_EQ(back.rays.size(), rays.size());
+    EXPECT_EQ(back.times, times);
+    for (std::size_t i = 0; i < rays.size(); ++i) EXPECT_TRUE(same_bits(back.rays[i].tfar, rays[i].tfar)) << i;
+    write_rays(path("u.rays"), RayKind::ClosestHit, rays);
+    EXPECT_TRUE(read_rays(path("u.rays")).times.empty());
+    times[7] = std::numeric_limits<float>::quiet_NaN();
+    write_rays(path("n.rays"), RayKind::ClosestHit, rays, times);
+    expect_error([&] { read_rays(path("n.rays")); }, path("n.rays"), "ray 7 has a non-finite time");
+    // A version 2 header over version 1 records does not add up.
+    std::string v1 = slurp(path("u.rays"));
+    v1[7] = '2';
+    spit(path("m.rays"), v1);
+    expect_error([&] { read_rays(path("m.rays")); }, path("m.rays"), "truncated");
+}
+
 TEST_F(RayFile, EmptyFilesRoundTrip) {
     write_rays(path("e.rays"), RayKind::AnyHit, {});
     const raypack::RayFile r = read_rays(path("e.rays"));
@@ -171,7 +202,7 @@ TEST_F(RayFile, HitsRoundTripBitExact) {
 TEST_F(RayFile, BadMagicRejected) {
     write_rays(path("a.rays"), RayKind::ClosestHit, sample_rays());
     std::string bytes = slurp(path("a.rays"));
-    bytes[7] = '2';  // RAYS0002
+    bytes[7] = '3';  // RAYS0003: no such version (RAYS0002 is the timed one)
     spit(path("b.rays"), bytes);
     expect_error([&] { read_rays(path("b.rays")); }, path("b.rays"), "bad magic");
     // A hits file is not a rays file and vice versa.

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "accel/accel.h"
+#include "accel/primitive_intersector.h"
 #include "kernels/aabb.h"
 
 namespace raypack {
@@ -24,30 +25,41 @@ constexpr float kPlacementCost = 4.0f;
 constexpr int kMedianDepth = 48;
 constexpr int kStack = 128;
 
-Vec3f centroid(const Instance& inst) { return (inst.bounds_start.center() + inst.bounds_end.center()) * 0.5f; }
 
 float motion_cost(const Box3f& start, const Box3f& end) { return 0.5f * (start.half_area() + end.half_area()); }
 
 }  // namespace
 
-Box3f interpolate_box(const Box3f& a, const Box3f& b, float s) {
-    Box3f r;
+void pad_for_lerp(Box3f& a, Box3f& b) {
     for (int k = 0; k < 3; ++k) {
-        const float lo = (1.0f - s) * a.lo[k] + s * b.lo[k];
-        const float hi = (1.0f - s) * a.hi[k] + s * b.hi[k];
-        // Each of the two products and the sum rounds once: 4e-7 of the
+        // Each of the two products and the sum round once: 4e-7 of the
         // magnitudes is over three ULPs of either.
-        const float pad_lo = (std::fabs(a.lo[k]) + std::fabs(b.lo[k])) * 4e-7f;
-        const float pad_hi = (std::fabs(a.hi[k]) + std::fabs(b.hi[k])) * 4e-7f;
-        r.lo[k] = lo - pad_lo;
-        r.hi[k] = hi + pad_hi;
+        const float lo = (std::fabs(a.lo[k]) + std::fabs(b.lo[k])) * 4e-7f;
+        const float hi = (std::fabs(a.hi[k]) + std::fabs(b.hi[k])) * 4e-7f;
+        a.lo[k] -= lo, b.lo[k] -= lo;
+        a.hi[k] += hi, b.hi[k] += hi;
     }
-    return r;
 }
 
-MotionBvh::MotionBvh(const Scene& scene, const ObjectAccels& objects, bool brute)
-    : scene_(scene), objects_(objects), brute_(brute) {
-    const auto n = std::uint32_t(scene.moving_instances.size());
+MotionBvh::MotionBvh(const Scene& scene, const ObjectAccels& objects, const KernelChoice& kernels, bool brute)
+    : scene_(scene), objects_(objects), kernels_(kernels), brute_(brute) {
+    std::vector<std::uint32_t> placed(scene.objects.size(), 0);
+    for (const Instance& inst : scene.instances) ++placed[inst.object];
+    for (const Instance& inst : scene.moving_instances) ++placed[inst.object];
+    for (std::uint32_t k = 0; k < scene.moving_instances.size(); ++k) {
+        const Instance& inst = scene.moving_instances[k];
+        const Scene& object = *scene.objects[inst.object];
+        if (placed[inst.object] > 1 || object.placements()) {
+            items_.push_back({inst.bounds_start, inst.bounds_end, k, kNoPrim});
+            continue;
+        }
+        for (std::uint32_t p = 0; p < object.primitive_count(); ++p) {
+            const Box3f box = primitive_bounds(object, p);
+            items_.push_back({transform_box(inst.to_world, box), transform_box(inst.to_world_end, box), k, p});
+        }
+    }
+    const auto n = std::uint32_t(items_.size());
+    for (Item& item : items_) pad_for_lerp(item.start, item.end);
     order_.resize(n);
     for (std::uint32_t k = 0; k < n; ++k) order_[k] = k;
     if (brute_ || n == 0) return;
@@ -58,16 +70,17 @@ MotionBvh::MotionBvh(const Scene& scene, const ObjectAccels& objects, bool brute
 
 void MotionBvh::build(std::uint32_t node, std::uint32_t begin, std::uint32_t end, int depth) {
     depth_ = std::max(depth_, depth);
-    const auto& insts = scene_.moving_instances;
+    const auto centroid = [&](std::uint32_t k) { return (items_[k].start.center() + items_[k].end.center()) * 0.5f; };
     Box3f start, endb, centres;
     for (std::uint32_t i = begin; i < end; ++i) {
-        const Instance& inst = insts[order_[i]];
-        start.extend(inst.bounds_start);
-        endb.extend(inst.bounds_end);
-        centres.extend(centroid(inst));
+        const Item& item = items_[order_[i]];
+        start.extend(item.start);
+        endb.extend(item.end);
+        centres.extend(centroid(order_[i]));
     }
     nodes_[node].start = start;
     nodes_[node].end = endb;
+    pad_for_lerp(nodes_[node].start, nodes_[node].end);
     const std::uint32_t count = end - begin;
     const auto make_leaf = [&] {
         nodes_[node].first = begin;
@@ -76,7 +89,7 @@ void MotionBvh::build(std::uint32_t node, std::uint32_t begin, std::uint32_t end
     if (count == 1) return make_leaf();
     const Vec3f ext = centres.extent();
     const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
-    const auto key = [&](std::uint32_t k) { return centroid(insts[k])[axis]; };
+    const auto key = [&](std::uint32_t k) { return centroid(k)[axis]; };
     std::uint32_t mid = begin;
     if (depth < kMedianDepth && ext[axis] > 0) {
         struct Bin {
@@ -90,9 +103,8 @@ void MotionBvh::build(std::uint32_t node, std::uint32_t begin, std::uint32_t end
         };
         for (std::uint32_t i = begin; i < end; ++i) {
             Bin& b = bins[std::size_t(bin_of(order_[i]))];
-            const Instance& inst = insts[order_[i]];
-            b.start.extend(inst.bounds_start);
-            b.end.extend(inst.bounds_end);
+            b.start.extend(items_[order_[i]].start);
+            b.end.extend(items_[order_[i]].end);
             ++b.count;
         }
         // Costs of the right side of each plane, then the sweep from the left.
@@ -147,27 +159,32 @@ void MotionBvh::build(std::uint32_t node, std::uint32_t begin, std::uint32_t end
 }
 
 template <bool AnyHit>
-bool MotionBvh::test_placement(std::uint32_t k, const Rayf& ray, const Vec3f& inv_dir, float s, Hitf& hit) const {
-    const Instance& inst = scene_.moving_instances[k];
+bool MotionBvh::test_item(std::uint32_t k, const Rayf& ray, const Vec3f& inv_dir, float s, Hitf& hit) const {
+    const Item& item = items_[k];
+    const Instance& inst = scene_.moving_instances[item.instance];
     const float tfar = hit.found() ? std::min(ray.tfar, hit.t) : ray.tfar;
     if (!brute_) {
         float entry;
-        if (!intersect_aabb(ray.org, inv_dir, interpolate_box(inst.bounds_start, inst.bounds_end, s), ray.tnear, tfar,
-                            entry))
+        if (!intersect_aabb(ray.org, inv_dir, lerp_box(item.start, item.end, s), ray.tnear, tfar, entry))
             return false;
     }
     Rayf r = ray_in_object(inst.to_object_at(s), ray);
     r.tfar = tfar;
-    const Accel& object = *objects_.accels[inst.object];
-    if constexpr (AnyHit) {
-        return object.occluded1(r);
+    Hitf h;
+    if (item.prim != kNoPrim) {
+        const PrimitiveIntersector<float> prims{scene_.objects[inst.object].get(), kernels_};
+        if (!prims.intersect(item.prim, r, h)) return false;
     } else {
-        const Hitf h = object.intersect1(r);
-        if (!h.found() || (hit.found() && !(h.t < hit.t))) return false;
-        hit = h;
-        hit.prim = inst.first_hit_id + h.prim;
-        return true;
+        const Accel& object = *objects_.accels[inst.object];
+        if constexpr (AnyHit) return object.occluded1(r);
+        h = object.intersect1(r);
+        if (!h.found()) return false;
     }
+    if constexpr (AnyHit) return true;
+    if (hit.found() && !(h.t < hit.t)) return false;
+    hit = h;
+    hit.prim = inst.first_hit_id + h.prim;
+    return true;
 }
 
 template <bool AnyHit>
@@ -175,8 +192,8 @@ bool MotionBvh::walk(const Rayf& ray, float s, Hitf& hit) const {
     const Vec3f inv_dir = reciprocal(ray.dir);
     bool found = false;
     if (brute_) {
-        for (std::uint32_t k = 0; k < order_.size(); ++k) {
-            if (!test_placement<AnyHit>(k, ray, inv_dir, s, hit)) continue;
+        for (std::uint32_t k = 0; k < items_.size(); ++k) {
+            if (!test_item<AnyHit>(k, ray, inv_dir, s, hit)) continue;
             if constexpr (AnyHit) return true;
             found = true;
         }
@@ -193,7 +210,7 @@ bool MotionBvh::walk(const Rayf& ray, float s, Hitf& hit) const {
     Entry stack[kStack];
     int top = 0;
     const auto meets = [&](const Node& n, float tfar, float& entry) {
-        return intersect_aabb(ray.org, inv_dir, interpolate_box(n.start, n.end, s), ray.tnear, tfar, entry);
+        return intersect_aabb(ray.org, inv_dir, lerp_box(n.start, n.end, s), ray.tnear, tfar, entry);
     };
     float root_entry;
     if (!meets(nodes_[0], ray.tfar, root_entry)) return false;
@@ -205,7 +222,7 @@ bool MotionBvh::walk(const Rayf& ray, float s, Hitf& hit) const {
         const Node& node = nodes_[e.node];
         if (node.count > 0) {
             for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
-                if (!test_placement<AnyHit>(order_[i], ray, inv_dir, s, hit)) continue;
+                if (!test_item<AnyHit>(order_[i], ray, inv_dir, s, hit)) continue;
                 if constexpr (AnyHit) return true;
                 found = true;
             }

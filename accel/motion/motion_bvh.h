@@ -10,12 +10,17 @@
 // interpolated end boxes hold it at every time and one tree serves the
 // whole shutter; time segments pay when motion has many steps.
 //
-// Each placement is traced in its object's structure (built once, shared
-// with the static placements) after the ray goes to object space with the
+// The tree's items are of two kinds. A placement whose object is placed
+// only once and places nothing itself (every `move` group) contributes its
+// primitives, each with its own moving box: motion-blurred geometry, as
+// Embree puts moving triangles in its motion BVH. Any other placement is
+// one item traced in its object's structure (built once, shared with the
+// static placements). Either way the ray goes to object space with the
 // inverse of the matrix interpolated at the ray's time.
 #include <cstdint>
 #include <vector>
 
+#include "accel/kernel_choice.h"
 #include "accel/prims/instance_prims.h"
 #include "kernels/ray.h"
 #include "scene/scene.h"
@@ -27,7 +32,7 @@ public:
     /// Over scene.moving_instances, whose objects' structures are `objects`.
     /// `brute`: no tree and no box test, every placement for every ray (the
     /// oracle's answer at the ray's time).
-    MotionBvh(const Scene& scene, const ObjectAccels& objects, bool brute);
+    MotionBvh(const Scene& scene, const ObjectAccels& objects, const KernelChoice& kernels, bool brute);
 
     /// Closest hit of `ray` at shutter fraction `s` among the moving
     /// placements, if closer than hit (when found) and within the ray's
@@ -37,7 +42,10 @@ public:
     bool occluded(const Rayf& ray, float s) const;
 
     std::size_t node_count() const { return nodes_.size(); }
-    std::size_t bytes() const { return nodes_.size() * sizeof(Node) + order_.size() * sizeof(std::uint32_t); }
+    std::size_t bytes() const {
+        return nodes_.size() * sizeof(Node) + items_.size() * sizeof(Item) + order_.size() * sizeof(std::uint32_t);
+    }
+    std::size_t item_count() const { return items_.size(); }
     int depth() const { return depth_; }
 
 private:
@@ -48,23 +56,41 @@ private:
         std::uint32_t first = 0, count = 0;
     };
 
+    /// A moving placement (prim == kNoPrim: traced in its object's
+    /// structure) or one primitive of its object; boxes at the two ends.
+    struct Item {
+        Box3f start, end;
+        std::uint32_t instance;  ///< into scene_.moving_instances
+        std::uint32_t prim;
+    };
+
     template <bool AnyHit>
     bool walk(const Rayf& ray, float s, Hitf& hit) const;
-    /// The placement's own interpolated box, then its object.
+    /// The item's own interpolated box, then its primitive or object.
     template <bool AnyHit>
-    bool test_placement(std::uint32_t k, const Rayf& ray, const Vec3f& inv_dir, float s, Hitf& hit) const;
+    bool test_item(std::uint32_t k, const Rayf& ray, const Vec3f& inv_dir, float s, Hitf& hit) const;
     void build(std::uint32_t node, std::uint32_t begin, std::uint32_t end, int depth);
 
     const Scene& scene_;
     const ObjectAccels& objects_;
+    KernelChoice kernels_;
     bool brute_;
+    std::vector<Item> items_;
     std::vector<Node> nodes_;
-    std::vector<std::uint32_t> order_;  ///< indices into scene_.moving_instances
+    std::vector<std::uint32_t> order_;  ///< item indices, in tree order
     int depth_ = 0;
 };
 
-/// The box (1 - s) a + s b, grown by a few ULPs of its coordinates so that
-/// the rounding of the interpolation never cuts off what it bounds.
-Box3f interpolate_box(const Box3f& a, const Box3f& b, float s);
+/// Boxes a and b (of one thing at the shutter's two ends) each grown by a
+/// few ULPs of both, so that lerp_box's rounding never cuts off what the
+/// exact interpolation bounds; done once, when the tree is built.
+void pad_for_lerp(Box3f& a, Box3f& b);
+
+/// (1 - s) a + s b, corner by corner.
+inline Box3f lerp_box(const Box3f& a, const Box3f& b, float s) {
+    const float r = 1.0f - s;
+    return {{r * a.lo.x + s * b.lo.x, r * a.lo.y + s * b.lo.y, r * a.lo.z + s * b.lo.z},
+            {r * a.hi.x + s * b.hi.x, r * a.hi.y + s * b.hi.y, r * a.hi.z + s * b.hi.z}};
+}
 
 }  // namespace raypack
