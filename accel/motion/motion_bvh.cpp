@@ -2,11 +2,15 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
+#include <stdexcept>
 #include <cmath>
 
 #include "accel/accel.h"
 #include "accel/primitive_intersector.h"
+#include "accel/prims/leaf_common.h"
 #include "kernels/aabb.h"
+#include "kernels/simd.h"
 
 namespace raypack {
 
@@ -23,7 +27,7 @@ constexpr float kPlacementCost = 4.0f;
 /// Past this depth, splits are at the median (so that the depth stays
 /// bounded whatever the boxes); the walk's stack holds kStack nodes.
 constexpr int kMedianDepth = 48;
-constexpr int kStack = 128;
+constexpr int kStack = 256;
 
 
 float motion_cost(const Box3f& start, const Box3f& end) { return 0.5f * (start.half_area() + end.half_area()); }
@@ -63,9 +67,86 @@ MotionBvh::MotionBvh(const Scene& scene, const ObjectAccels& objects, const Kern
     order_.resize(n);
     for (std::uint32_t k = 0; k < n; ++k) order_[k] = k;
     if (brute_ || n == 0) return;
+    if (n >= (1u << 28)) throw std::length_error("motion BVH: more than 2^28 moving items");
     nodes_.reserve(2 * std::size_t(n));
     nodes_.emplace_back();
     build(0, 0, n, 1);
+    collapse(0);
+    nodes_ = {};
+}
+
+std::uint32_t MotionBvh::collapse(std::uint32_t node) {
+    // Open the costliest inner child until there are four (Embree's collapse).
+    std::uint32_t kids[kWidth];
+    int count = 0;
+    if (nodes_[node].count > 0) {
+        kids[count++] = node;  // a leaf root: one child
+    } else {
+        kids[count++] = nodes_[node].first;
+        kids[count++] = nodes_[node].first + 1;
+        while (count < kWidth) {
+            int open = -1;
+            float best = -1;
+            for (int j = 0; j < count; ++j) {
+                const Node& c = nodes_[kids[j]];
+                const float cost = motion_cost(c.start, c.end);
+                if (c.count == 0 && cost > best) best = cost, open = j;
+            }
+            if (open < 0) break;
+            const std::uint32_t first = nodes_[kids[open]].first;
+            kids[open] = first;
+            kids[count++] = first + 1;
+        }
+    }
+    const auto index = std::uint32_t(wide_.size());
+    wide_.emplace_back();
+    for (int j = 0; j < kWidth; ++j) {
+        const bool used = j < count;
+        const Node& c = nodes_[used ? kids[j] : node];
+        for (int k = 0; k < 3; ++k) {
+            wide_[index].lo0[k][j] = used ? c.start.lo[k] : 0.0f;
+            wide_[index].hi0[k][j] = used ? c.start.hi[k] : 0.0f;
+            wide_[index].lo1[k][j] = used ? c.end.lo[k] : 0.0f;
+            wide_[index].hi1[k][j] = used ? c.end.hi[k] : 0.0f;
+        }
+        wide_[index].child[j] = kEmpty;
+    }
+    for (int j = 0; j < count; ++j) {
+        const Node& c = nodes_[kids[j]];
+        const std::uint32_t code = c.count > 0 ? kLeaf | c.first << 3 | c.count : collapse(kids[j]);
+        wide_[index].child[j] = code;
+    }
+    return index;
+}
+
+RAYPACK_INLINE std::uint32_t MotionBvh::meet_children(const WideNode& n, const Rayf& ray, const Vec3f& inv_dir, float s, float tfar,
+                                       float* entry) const {
+    std::uint32_t valid = 0;
+    for (int j = 0; j < kWidth; ++j) valid |= std::uint32_t(n.child[j] != kEmpty) << j;
+#if defined(__SSE4_2__)
+    using F = vfloat<kWidth>;
+    const F r(1.0f - s), t(s);
+    const auto lerp = [&](const float (&a)[3][kWidth], const float (&b)[3][kWidth]) {
+        return Vec3<F>{r * F::load_unaligned(a[0]) + t * F::load_unaligned(b[0]),
+                       r * F::load_unaligned(a[1]) + t * F::load_unaligned(b[1]),
+                       r * F::load_unaligned(a[2]) + t * F::load_unaligned(b[2])};
+    };
+    const SlabRay<F> slab{splat<F>(ray.org), splat<F>(inv_dir), {}, F(ray.tnear), F(tfar)};
+    F in;
+    const mask_of<F> hit = intersect_box<SlabMethod::Robust, F>(mask_of<F>(true), slab, lerp(n.lo0, n.lo1),
+                                                                lerp(n.hi0, n.hi1), in);
+    in.store_unaligned(entry);
+    return valid & std::uint32_t(mask_bits(hit));
+#else
+    std::uint32_t bits = 0;
+    for (int j = 0; j < kWidth; ++j) {
+        if (!((valid >> j) & 1u)) continue;
+        const Box3f a{{n.lo0[0][j], n.lo0[1][j], n.lo0[2][j]}, {n.hi0[0][j], n.hi0[1][j], n.hi0[2][j]}};
+        const Box3f b{{n.lo1[0][j], n.lo1[1][j], n.lo1[2][j]}, {n.hi1[0][j], n.hi1[1][j], n.hi1[2][j]}};
+        bits |= std::uint32_t(intersect_aabb(ray.org, inv_dir, lerp_box(a, b, s), ray.tnear, tfar, entry[j])) << j;
+    }
+    return bits;
+#endif
 }
 
 void MotionBvh::build(std::uint32_t node, std::uint32_t begin, std::uint32_t end, int depth) {
@@ -159,11 +240,12 @@ void MotionBvh::build(std::uint32_t node, std::uint32_t begin, std::uint32_t end
 }
 
 template <bool AnyHit>
-bool MotionBvh::test_item(std::uint32_t k, const Rayf& ray, const Vec3f& inv_dir, float s, Hitf& hit) const {
+bool MotionBvh::test_item(std::uint32_t k, const Rayf& ray, const Vec3f& inv_dir, float s, Hitf& hit,
+                          bool box_tested) const {
     const Item& item = items_[k];
     const Instance& inst = scene_.moving_instances[item.instance];
     const float tfar = hit.found() ? std::min(ray.tfar, hit.t) : ray.tfar;
-    if (!brute_) {
+    if (!box_tested) {
         float entry;
         if (!intersect_aabb(ray.org, inv_dir, lerp_box(item.start, item.end, s), ray.tnear, tfar, entry))
             return false;
@@ -193,53 +275,46 @@ bool MotionBvh::walk(const Rayf& ray, float s, Hitf& hit) const {
     bool found = false;
     if (brute_) {
         for (std::uint32_t k = 0; k < items_.size(); ++k) {
-            if (!test_item<AnyHit>(k, ray, inv_dir, s, hit)) continue;
+            if (!test_item<AnyHit>(k, ray, inv_dir, s, hit, true)) continue;
             if constexpr (AnyHit) return true;
             found = true;
         }
         return found;
     }
-    if (nodes_.empty()) return false;
+    if (wide_.empty()) return false;
     // Boxes are tested when their parent is visited; the stack keeps each
-    // node's entry distance, so that one farther than a hit found since is
-    // dropped.
+    // child's entry distance, so that one farther than a hit found since is
+    // dropped. Children go on nearest last, so visited first.
     struct Entry {
-        std::uint32_t node;
+        std::uint32_t child;
         float entry;
     };
     Entry stack[kStack];
     int top = 0;
-    const auto meets = [&](const Node& n, float tfar, float& entry) {
-        return intersect_aabb(ray.org, inv_dir, lerp_box(n.start, n.end, s), ray.tnear, tfar, entry);
-    };
-    float root_entry;
-    if (!meets(nodes_[0], ray.tfar, root_entry)) return false;
-    stack[top++] = {0, root_entry};
+    stack[top++] = {0, ray.tnear};
     while (top > 0) {
         const Entry e = stack[--top];
         const float tfar = hit.found() ? std::min(ray.tfar, hit.t) : ray.tfar;
         if (e.entry > tfar) continue;
-        const Node& node = nodes_[e.node];
-        if (node.count > 0) {
-            for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
-                if (!test_item<AnyHit>(order_[i], ray, inv_dir, s, hit)) continue;
+        if (e.child & kLeaf) {
+            const std::uint32_t first = (e.child & ~kLeaf) >> 3, count = e.child & 7u;
+            // A leaf of one item: its box was the leaf's, tested already.
+            for (std::uint32_t i = first; i < first + count; ++i) {
+                if (!test_item<AnyHit>(order_[i], ray, inv_dir, s, hit, count == 1)) continue;
                 if constexpr (AnyHit) return true;
                 found = true;
             }
             continue;
         }
-        // The nearer child is pushed last, so visited first.
-        float ea = INFINITY, eb = INFINITY;
-        const bool ha = meets(nodes_[node.first], tfar, ea);
-        const bool hb = meets(nodes_[node.first + 1], tfar, eb);
-        if (ha && hb) {
-            const bool a_first = ea <= eb;
-            stack[top++] = a_first ? Entry{node.first + 1, eb} : Entry{node.first, ea};
-            stack[top++] = a_first ? Entry{node.first, ea} : Entry{node.first + 1, eb};
-        } else if (ha) {
-            stack[top++] = {node.first, ea};
-        } else if (hb) {
-            stack[top++] = {node.first + 1, eb};
+        float entry[kWidth];
+        std::uint32_t bits = meet_children(wide_[e.child], ray, inv_dir, s, tfar, entry);
+        const int base = top;
+        for (; bits != 0; bits &= bits - 1) {
+            const int j = std::countr_zero(bits);
+            // Insertion by decreasing entry: the nearest ends on top.
+            int k = top++;
+            while (k > base && stack[k - 1].entry < entry[j]) stack[k] = stack[k - 1], --k;
+            stack[k] = {wide_[e.child].child[j], entry[j]};
         }
     }
     return found;

@@ -1,10 +1,10 @@
 #pragma once
 // Placements that move over the shutter (Scene::moving_instances) in a
-// binary BVH whose nodes keep two boxes, one at the shutter's opening and
-// one at its closing; a ray at shutter fraction s tests the box
-// interpolated at s. This is Embree's linear motion BVH (BVH4MB, Woop et
-// al. 2017, "Embree ray tracing kernels: overview and new features") in
-// binary form. Linear bounds rather than time-segmented nodes: each
+// 4-wide BVH whose nodes keep two boxes per child, one at the shutter's
+// opening and one at its closing; a ray at shutter fraction s tests the
+// four boxes interpolated at s in SIMD lanes. This is Embree's linear
+// motion BVH (BVH4MB, Woop et al. 2017, "Embree ray tracing kernels:
+// overview and new features"), built as a binary SAH tree and collapsed. Linear bounds rather than time-segmented nodes: each
 // placement here moves along one linear segment (NFF `move`, or `inst`
 // with two matrices), every point of it on a straight line, so the
 // interpolated end boxes hold it at every time and one tree serves the
@@ -41,19 +41,28 @@ public:
     /// Whether a moving placement blocks the ray's span at fraction `s`.
     bool occluded(const Rayf& ray, float s) const;
 
-    std::size_t node_count() const { return nodes_.size(); }
+    std::size_t node_count() const { return wide_.size(); }
     std::size_t bytes() const {
-        return nodes_.size() * sizeof(Node) + items_.size() * sizeof(Item) + order_.size() * sizeof(std::uint32_t);
+        return wide_.size() * sizeof(WideNode) + items_.size() * sizeof(Item) + order_.size() * sizeof(std::uint32_t);
     }
     std::size_t item_count() const { return items_.size(); }
     int depth() const { return depth_; }
 
 private:
-    /// Inner node: count == 0, children at first and first + 1. Leaf:
-    /// placements order_[first .. first + count).
+    /// The binary tree of the build. Inner node: count == 0, children at
+    /// first and first + 1. Leaf: items order_[first .. first + count).
     struct Node {
         Box3f start, end;
         std::uint32_t first = 0, count = 0;
+    };
+    /// The traversed tree: four children's boxes at the two ends, SoA.
+    /// child[j]: a node index, a leaf (kLeaf | first << 3 | count), or
+    /// kEmpty (a slot the lanes mask off).
+    static constexpr int kWidth = 4;
+    static constexpr std::uint32_t kLeaf = 1u << 31, kEmpty = 0xFFFFFFFFu;
+    struct WideNode {
+        float lo0[3][kWidth], hi0[3][kWidth], lo1[3][kWidth], hi1[3][kWidth];
+        std::uint32_t child[kWidth];
     };
 
     /// A moving placement (prim == kNoPrim: traced in its object's
@@ -66,17 +75,26 @@ private:
 
     template <bool AnyHit>
     bool walk(const Rayf& ray, float s, Hitf& hit) const;
-    /// The item's own interpolated box, then its primitive or object.
+    /// The item's own interpolated box (unless `box_tested`: brute force
+    /// tests none, a leaf of one item tested it as the leaf's), then its
+    /// primitive or object.
     template <bool AnyHit>
-    bool test_item(std::uint32_t k, const Rayf& ray, const Vec3f& inv_dir, float s, Hitf& hit) const;
+    bool test_item(std::uint32_t k, const Rayf& ray, const Vec3f& inv_dir, float s, Hitf& hit, bool box_tested) const;
     void build(std::uint32_t node, std::uint32_t begin, std::uint32_t end, int depth);
+    /// The wide node over binary node `node`'s (up to four) descendants.
+    std::uint32_t collapse(std::uint32_t node);
+    /// Bits of the children of `n` whose boxes at s meet the ray's span,
+    /// with their entry distances.
+    std::uint32_t meet_children(const WideNode& n, const Rayf& ray, const Vec3f& inv_dir, float s, float tfar,
+                                float* entry) const;
 
     const Scene& scene_;
     const ObjectAccels& objects_;
     KernelChoice kernels_;
     bool brute_;
     std::vector<Item> items_;
-    std::vector<Node> nodes_;
+    std::vector<Node> nodes_;  ///< the build's; emptied once collapsed
+    std::vector<WideNode> wide_;
     std::vector<std::uint32_t> order_;  ///< item indices, in tree order
     int depth_ = 0;
 };
