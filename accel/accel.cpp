@@ -1,5 +1,6 @@
 #include "accel/accel.h"
 
+#include <algorithm>
 #include <chrono>
 #include <stdexcept>
 
@@ -102,14 +103,28 @@ private:
     float fraction(std::span<const float> times, std::size_t i) const {
         return times.empty() ? 0.0f : scene_.shutter_fraction(times[i]);
     }
+    /// Each ray's shutter fraction, in batches of kMotionBatch.
+    static constexpr std::size_t kMotionBatch = 256;
+    template <class F>
+    void in_batches(std::span<const Rayf> rays, std::span<const float> times, F&& f) const {
+        float fractions[kMotionBatch];
+        for (std::size_t b = 0; b < rays.size(); b += kMotionBatch) {
+            const std::size_t n = std::min(kMotionBatch, rays.size() - b);
+            for (std::size_t i = 0; i < n; ++i) fractions[i] = fraction(times, b + i);
+            f(b, n, std::span<const float>(fractions, n));
+        }
+    }
     void add_motion(std::span<const Rayf> rays, std::span<const float> times, std::span<Hitf> hits) const {
         if (!motion_) return;
-        for (std::size_t i = 0; i < rays.size(); ++i) motion_->intersect(rays[i], fraction(times, i), hits[i]);
+        in_batches(rays, times, [&](std::size_t b, std::size_t n, std::span<const float> s) {
+            motion_->intersect(rays.subspan(b, n), s, hits.subspan(b, n));
+        });
     }
     void add_motion(std::span<const Rayf> rays, std::span<const float> times, std::span<std::uint8_t> out) const {
         if (!motion_) return;
-        for (std::size_t i = 0; i < rays.size(); ++i)
-            if (!out[i]) out[i] = motion_->occluded(rays[i], fraction(times, i)) ? 1 : 0;
+        in_batches(rays, times, [&](std::size_t b, std::size_t n, std::span<const float> s) {
+            motion_->occluded(rays.subspan(b, n), s, out.subspan(b, n));
+        });
     }
 
     const Scene& scene_;

@@ -4,9 +4,11 @@
 #include <array>
 #include <bit>
 #include <stdexcept>
+#include <type_traits>
 #include <cmath>
 
 #include "accel/accel.h"
+#include "accel/packet_intersector.h"
 #include "accel/primitive_intersector.h"
 #include "accel/prims/leaf_common.h"
 #include "kernels/aabb.h"
@@ -28,6 +30,17 @@ constexpr float kPlacementCost = 4.0f;
 /// bounded whatever the boxes); the walk's stack holds kStack nodes.
 constexpr int kMedianDepth = 48;
 constexpr int kStack = 256;
+/// Packet width of the batch queries: the widest the build compiles.
+#if defined(__AVX512BW__)
+constexpr int kPacket = 16;
+#elif defined(__AVX2__)
+constexpr int kPacket = 8;
+#elif defined(__SSE4_2__)
+constexpr int kPacket = 4;
+#else
+constexpr int kPacket = 1;
+#endif
+
 
 
 float motion_cost(const Box3f& start, const Box3f& end) { return 0.5f * (start.half_area() + end.half_area()); }
@@ -270,7 +283,7 @@ bool MotionBvh::test_item(std::uint32_t k, const Rayf& ray, const Vec3f& inv_dir
 }
 
 template <bool AnyHit>
-bool MotionBvh::walk(const Rayf& ray, float s, Hitf& hit) const {
+bool MotionBvh::walk(const Rayf& ray, float s, Hitf& hit, std::uint32_t start) const {
     const Vec3f inv_dir = reciprocal(ray.dir);
     bool found = false;
     if (brute_) {
@@ -291,7 +304,7 @@ bool MotionBvh::walk(const Rayf& ray, float s, Hitf& hit) const {
     };
     Entry stack[kStack];
     int top = 0;
-    stack[top++] = {0, ray.tnear};
+    stack[top++] = {start, ray.tnear};
     while (top > 0) {
         const Entry e = stack[--top];
         const float tfar = hit.found() ? std::min(ray.tfar, hit.t) : ray.tfar;
@@ -325,6 +338,197 @@ void MotionBvh::intersect(const Rayf& ray, float s, Hitf& hit) const { walk<fals
 bool MotionBvh::occluded(const Rayf& ray, float s) const {
     Hitf none;
     return walk<true>(ray, s, none);
+}
+
+template <class F, bool AnyHit>
+void MotionBvh::walk_packet(const Rayf* rays, const float* fractions, int count, Hitf* hits,
+                            std::uint8_t* occluded) const {
+    constexpr int K = lanes_of<F>;
+    constexpr int kFewLanes = K / 4;
+    alignas(64) float ox[K], oy[K], oz[K], rx[K], ry[K], rz[K], tn[K], tf[K], sv[K];
+    Vec3f inv[K];
+    for (int l = 0; l < K; ++l) {
+        // Lanes past the count: an empty span, which meets no box.
+        const Rayf r = l < count ? rays[l] : Rayf{{0, 0, 0}, {1, 1, 1}, 1.0f, 0.0f};
+        inv[l] = reciprocal(r.dir);
+        ox[l] = r.org.x, oy[l] = r.org.y, oz[l] = r.org.z;
+        rx[l] = inv[l].x, ry[l] = inv[l].y, rz[l] = inv[l].z;
+        tn[l] = r.tnear;
+        tf[l] = l < count && !AnyHit && hits[l].found() ? std::min(r.tfar, hits[l].t) : r.tfar;
+        sv[l] = l < count ? fractions[l] : 0.0f;
+    }
+    const Vec3<F> org{F::load_aligned(ox), F::load_aligned(oy), F::load_aligned(oz)};
+    const Vec3<F> rdir{F::load_aligned(rx), F::load_aligned(ry), F::load_aligned(rz)};
+    const F tnear = F::load_aligned(tn), s = F::load_aligned(sv), r = F(1.0f) - s;
+    std::uint32_t live = count >= 32 ? ~0u : (1u << count) - 1u;
+    struct Entry {
+        std::uint32_t child;
+        std::uint32_t lanes;
+    };
+    Entry stack[kStack];
+    int top = 0;
+    stack[top++] = {0, live};
+    alignas(64) float entry[K];
+    while (top > 0) {
+        const Entry e = stack[--top];
+        const std::uint32_t lanes = e.lanes & live;
+        if (lanes == 0) continue;
+        if (std::popcount(lanes) <= kFewLanes) {
+            // Too few lanes left to share a node's work: each goes on alone
+            // (the static BVHs' single-ray fallback does the same).
+            for (std::uint32_t bits = lanes; bits != 0; bits &= bits - 1) {
+                const int l = std::countr_zero(bits);
+                if constexpr (AnyHit) {
+                    Hitf none;
+                    if (walk<true>(rays[l], sv[l], none, e.child)) occluded[l] = 1, live &= ~(1u << l);
+                } else if (walk<false>(rays[l], sv[l], hits[l], e.child)) {
+                    tf[l] = hits[l].t;
+                }
+            }
+            continue;
+        }
+        if (e.child & kLeaf) {
+            const std::uint32_t first = (e.child & ~kLeaf) >> 3, n = e.child & 7u;
+            std::uint32_t rest = 0;  // lanes for the placements traced in their objects' structures
+            for (std::uint32_t i = first; i < first + n; ++i) {
+                const Item& item = items_[order_[i]];
+                if (item.prim == kNoPrim) {
+                    rest = lanes;
+                    continue;
+                }
+                // A primitive: every lane at once, each ray taken to object
+                // space at its own time.
+                std::uint32_t bits = lanes & live;
+                if (bits == 0) break;
+                if (n > 1) {
+                    alignas(64) float on[K];
+                    for (int l = 0; l < K; ++l) on[l] = (bits >> l) & 1u ? 1.0f : 0.0f;
+                    const SlabRay<F> slab{org, rdir, {}, tnear, F::load_aligned(tf)};
+                    const Vec3<F> lo{r * F(item.start.lo.x) + s * F(item.end.lo.x), r * F(item.start.lo.y) + s * F(item.end.lo.y),
+                                     r * F(item.start.lo.z) + s * F(item.end.lo.z)};
+                    const Vec3<F> hi{r * F(item.start.hi.x) + s * F(item.end.hi.x), r * F(item.start.hi.y) + s * F(item.end.hi.y),
+                                     r * F(item.start.hi.z) + s * F(item.end.hi.z)};
+                    F in;
+                    bits = mask_bits(intersect_box<SlabMethod::Robust, F>(F::load_aligned(on) > F(0.0f), slab, lo, hi, in));
+                    if (bits == 0) continue;
+                }
+                const Instance& inst = scene_.moving_instances[item.instance];
+                alignas(64) float px[K], py[K], pz[K], dx[K], dy[K], dz[K], on[K];
+                for (int l = 0; l < K; ++l) {
+                    on[l] = (bits >> l) & 1u ? 1.0f : 0.0f;
+                    const Rayf q = on[l] != 0.0f ? ray_in_object(inst.to_object_at(sv[l]), rays[l]) : Rayf{{0, 0, 0}, {1, 1, 1}};
+                    px[l] = q.org.x, py[l] = q.org.y, pz[l] = q.org.z, dx[l] = q.dir.x, dy[l] = q.dir.y, dz[l] = q.dir.z;
+                }
+                RayLanes<F> q;
+                q.org = {F::load_aligned(px), F::load_aligned(py), F::load_aligned(pz)};
+                q.dir = {F::load_aligned(dx), F::load_aligned(dy), F::load_aligned(dz)};
+                q.rdir = reciprocal(q.dir);
+                q.tnear = tnear;
+                q.tfar = F::load_aligned(tf);
+                HitLanes<F> h;
+                h.t = F(INFINITY), h.u = h.v = F(0.0f);
+                const PacketPrimitiveIntersector<F> prims{scene_.objects[inst.object].get(), kernels_};
+                const mask_of<F> valid = F::load_aligned(on) > F(0.0f);
+                std::uint32_t got = mask_bits(prims.intersect(valid, q, h, item.prim));
+                if (got == 0) continue;
+                if constexpr (AnyHit) {
+                    for (std::uint32_t b = got; b != 0; b &= b - 1) occluded[std::countr_zero(b)] = 1;
+                    live &= ~got;
+                } else {
+                    alignas(64) float ht[K], hu[K], hv[K];
+                    h.t.store_aligned(ht), h.u.store_aligned(hu), h.v.store_aligned(hv);
+                    for (; got != 0; got &= got - 1) {
+                        const int l = std::countr_zero(got);
+                        // Only a nearer hit replaces one found (as the ray by ray walk).
+                        if (hits[l].found() && !(ht[l] < hits[l].t)) continue;
+                        hits[l] = Hitf{ht[l], inst.first_hit_id + h.prim[l], hu[l], hv[l]};
+                        tf[l] = ht[l];
+                    }
+                }
+            }
+            for (std::uint32_t bits = rest & live; bits != 0; bits &= bits - 1) {
+                const int l = std::countr_zero(bits);
+                for (std::uint32_t i = first; i < first + n; ++i) {
+                    if (items_[order_[i]].prim != kNoPrim) continue;
+                    if constexpr (AnyHit) {
+                        Hitf none;
+                        if (!test_item<true>(order_[i], rays[l], inv[l], sv[l], none, n == 1)) continue;
+                        occluded[l] = 1;
+                        live &= ~(1u << l);
+                        break;
+                    } else {
+                        if (test_item<false>(order_[i], rays[l], inv[l], sv[l], hits[l], n == 1)) tf[l] = hits[l].t;
+                    }
+                }
+            }
+            continue;
+        }
+        alignas(64) float on[K];
+        for (int l = 0; l < K; ++l) on[l] = (lanes >> l) & 1u ? 1.0f : 0.0f;
+        const mask_of<F> active = F::load_aligned(on) > F(0.0f);
+        const SlabRay<F> slab{org, rdir, {}, tnear, F::load_aligned(tf)};
+        const WideNode& node = wide_[e.child];
+        Entry next[kWidth];
+        float order[kWidth];
+        int m = 0;
+        for (int j = 0; j < kWidth; ++j) {
+            if (node.child[j] == kEmpty) continue;
+            const Vec3<F> lo{r * F(node.lo0[0][j]) + s * F(node.lo1[0][j]), r * F(node.lo0[1][j]) + s * F(node.lo1[1][j]),
+                             r * F(node.lo0[2][j]) + s * F(node.lo1[2][j])};
+            const Vec3<F> hi{r * F(node.hi0[0][j]) + s * F(node.hi1[0][j]), r * F(node.hi0[1][j]) + s * F(node.hi1[1][j]),
+                             r * F(node.hi0[2][j]) + s * F(node.hi1[2][j])};
+            F in;
+            const std::uint32_t hit = mask_bits(intersect_box<SlabMethod::Robust, F>(active, slab, lo, hi, in));
+            if (hit == 0) continue;
+            in.store_aligned(entry);
+            // Nearest first, judged by the first lane that meets the box.
+            const float key = entry[std::countr_zero(hit)];
+            int k = m++;
+            while (k > 0 && order[k - 1] < key) next[k] = next[k - 1], order[k] = order[k - 1], --k;
+            next[k] = {node.child[j], hit};
+            order[k] = key;
+        }
+        for (int k = 0; k < m; ++k) stack[top++] = next[k];
+    }
+}
+
+void MotionBvh::intersect(std::span<const Rayf> rays, std::span<const float> fractions, std::span<Hitf> hits) const {
+    if constexpr (kPacket > 1) {
+        if (!brute_) {
+            for (std::size_t b = 0; b < rays.size(); b += kPacket) {
+                const int n = int(std::min<std::size_t>(kPacket, rays.size() - b));
+                walk_packet<vfloat<kPacket>, false>(rays.data() + b, fractions.data() + b, n, hits.data() + b, nullptr);
+            }
+            return;
+        }
+    }
+    for (std::size_t i = 0; i < rays.size(); ++i) intersect(rays[i], fractions[i], hits[i]);
+}
+
+void MotionBvh::occluded(std::span<const Rayf> rays, std::span<const float> fractions,
+                         std::span<std::uint8_t> occluded) const {
+    if (brute_ || kPacket == 1) {
+        for (std::size_t i = 0; i < rays.size(); ++i)
+            if (!occluded[i]) occluded[i] = this->occluded(rays[i], fractions[i]) ? 1 : 0;
+        return;
+    }
+    if constexpr (kPacket > 1) for (std::size_t b = 0; b < rays.size(); b += kPacket) {
+        const int n = int(std::min<std::size_t>(kPacket, rays.size() - b));
+        // Rays already occluded (by the static part) take no lane.
+        Rayf open[kPacket];
+        float when[kPacket];
+        std::uint8_t out[kPacket];
+        std::size_t index[kPacket];
+        int m = 0;
+        for (int l = 0; l < n; ++l) {
+            if (occluded[b + std::size_t(l)]) continue;
+            open[m] = rays[b + std::size_t(l)], when[m] = fractions[b + std::size_t(l)], out[m] = 0;
+            index[m++] = b + std::size_t(l);
+        }
+        if (m == 0) continue;
+        walk_packet<vfloat<kPacket>, true>(open, when, m, nullptr, out);
+        for (int l = 0; l < m; ++l) occluded[index[l]] = out[l];
+    }
 }
 
 }  // namespace raypack

@@ -18,6 +18,7 @@
 // static placements). Either way the ray goes to object space with the
 // inverse of the matrix interpolated at the ray's time.
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "accel/kernel_choice.h"
@@ -40,6 +41,15 @@ public:
     void intersect(const Rayf& ray, float s, Hitf& hit) const;
     /// Whether a moving placement blocks the ray's span at fraction `s`.
     bool occluded(const Rayf& ray, float s) const;
+
+    /// The same for a batch of rays with their fractions, traced as packets
+    /// of kPacket rays (each lane at its own time) down the tree: a node's
+    /// boxes are fetched once per packet, and its four children tested for
+    /// all the packet's lanes in SIMD; items are tested lane by lane.
+    void intersect(std::span<const Rayf> rays, std::span<const float> fractions, std::span<Hitf> hits) const;
+    /// occluded[i] is set to 1 where a moving placement blocks ray i (it
+    /// is left as it is elsewhere).
+    void occluded(std::span<const Rayf> rays, std::span<const float> fractions, std::span<std::uint8_t> occluded) const;
 
     std::size_t node_count() const { return wide_.size(); }
     std::size_t bytes() const {
@@ -73,8 +83,12 @@ private:
         std::uint32_t prim;
     };
 
+    /// One ray down the subtree `start` (a child code; 0 is the root).
     template <bool AnyHit>
-    bool walk(const Rayf& ray, float s, Hitf& hit) const;
+    bool walk(const Rayf& ray, float s, Hitf& hit, std::uint32_t start = 0) const;
+    /// Up to a packet of rays: hits[l] (closest hits) or occluded[l] (AnyHit).
+    template <class F, bool AnyHit>
+    void walk_packet(const Rayf* rays, const float* fractions, int count, Hitf* hits, std::uint8_t* occluded) const;
     /// The item's own interpolated box (unless `box_tested`: brute force
     /// tests none, a leaf of one item tested it as the leaf's), then its
     /// primitive or object.
