@@ -138,6 +138,48 @@ TEST(Cli, TraceAnswersClosestAndAnyHitWithJson) {
     }
 }
 
+/// A scene that moves: rays carry times (a version 2 file), every one in
+/// the shutter, and trace answers at those times as brute force does; the
+/// same rays without their times (at the opening) answer differently.
+TEST(Cli, RaysAndTraceCarryTimesThroughAMovingScene) {
+    const fs::path dir = temp_dir();
+    const std::string scene = "gen:balls:2:motion";
+    for (const char* kind : {"camera", "shadow", "diffuse"}) {
+        const std::string rays = (dir / (std::string(kind) + ".rays")).string();
+        const Result made = run("rays " + scene + " --kind " + kind + " --res 40 40 -o " + rays);
+        ASSERT_EQ(made.status, 0) << made.output;
+        EXPECT_NE(made.output.find("with times over the shutter"), std::string::npos) << made.output;
+        const RayFile file = read_rays(rays);
+        ASSERT_EQ(file.times.size(), file.rays.size());
+        for (const float t : file.times) ASSERT_TRUE(t >= 0.0f && t <= 1.0f) << t;  // gen's shutter: 0 1
+        std::vector<Hitf> answers[2];
+        for (int k = 0; k < 2; ++k) {
+            const std::string hits = (dir / (std::string(kind) + std::to_string(k) + ".hits")).string();
+            const Result r = run("trace " + scene + " --rays " + rays + " -o " + hits + " --repeat 1" +
+                                 (k == 0 ? "" : " --accel brute"));
+            ASSERT_EQ(r.status, 0) << r.output;
+            answers[k] = read_hits(hits);
+        }
+        ASSERT_EQ(answers[0].size(), answers[1].size());
+        for (std::size_t i = 0; i < answers[0].size(); ++i) {
+            ASSERT_EQ(answers[0][i].found(), answers[1][i].found()) << kind << " ray " << i;
+            if (file.kind == RayKind::ClosestHit && answers[0][i].found()) {
+                ASSERT_EQ(answers[0][i].t, answers[1][i].t) << kind << " ray " << i;
+            }
+        }
+    }
+    // The camera rays at the shutter's opening (a version 1 file) see the balls elsewhere.
+    const RayFile timed = read_rays((dir / "camera.rays").string());
+    write_rays((dir / "untimed.rays").string(), timed.kind, timed.rays);
+    const std::string a = (dir / "a.hits").string(), b = (dir / "b.hits").string();
+    ASSERT_EQ(run("trace " + scene + " --rays " + (dir / "camera.rays").string() + " -o " + a + " --repeat 1").status, 0);
+    ASSERT_EQ(run("trace " + scene + " --rays " + (dir / "untimed.rays").string() + " -o " + b + " --repeat 1").status, 0);
+    const auto ha = read_hits(a), hb = read_hits(b);
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < ha.size(); ++i) differ += ha[i].t != hb[i].t;
+    EXPECT_GT(differ, ha.size() / 20);
+}
+
 /// With no structure, builder or width named, trace runs the fastest measured
 /// configuration for the kind of rays (app/default_config.cpp) and says so in --json; naming any of them turns that off.
 TEST(Cli, TraceDefaultsToTheFastestConfigurationForTheRays) {

@@ -15,6 +15,7 @@
 #include "render/image.h"
 #include "render/ray_offset.h"
 #include "render/surface.h"
+#include "render/path_tracer.h"
 #include "render/whitted.h"
 #include "scene/load.h"
 #include "scene/nff_text.h"
@@ -248,6 +249,42 @@ TEST(Motion, ASphereIsWhereItIsAtTheRaysTime) {
         const Vec3f n = normalize(p - Vec3f{time, 0, 0});
         EXPECT_LT(length(surf.geometric_normal - n), 1e-5f) << "time " << time;
     }
+}
+
+/// A shutter of no length freezes the motion at its opening: distribution
+/// and path-traced renders of the moving scene are those of the scene
+/// without its `move` lines (up to the rounding of normals renormalised on
+/// their way out of a placement).
+TEST(Motion, AFrozenShutterRendersTheStaticScene) {
+    std::string text = moving_scene_text(9, 0.0f, 0.0f);
+    const Scene frozen = parse(text);
+    ASSERT_FALSE(frozen.moving_instances.empty());
+    const Scene still = parse(moving_scene_text(9, 0.0f, 0.0f, true));
+    const auto a = build_accel(frozen, accel_config("bvh4"));
+    const auto b = build_accel(still, accel_config("bvh4"));
+    WhittedOptions o;
+    o.width = o.height = 32;
+    o.distribution = true;
+    o.spp = 4;
+    Image ia, ib;
+    render_whitted(frozen, *a, o, ia);
+    render_whitted(still, *b, o, ib);
+    double diff = 0;
+    for (std::size_t i = 0; i < ia.rgb.size(); ++i) diff = std::max(diff, double(std::fabs(ia.rgb[i] - ib.rgb[i])));
+    EXPECT_LT(diff, 1e-3);
+    PathOptions path;
+    render_path(frozen, *a, o, path, ia);
+    render_path(still, *b, o, path, ib);
+    double sum = 0;
+    for (std::size_t i = 0; i < ia.rgb.size(); ++i) sum += std::fabs(ia.rgb[i] - ib.rgb[i]);
+    EXPECT_LT(sum / double(ia.rgb.size()), 1e-3);
+    // And the moving scene over a real shutter renders otherwise.
+    const Scene moving = parse(moving_scene_text(9, 0.0f, 1.0f));
+    render_whitted(moving, *build_accel(moving, accel_config("bvh4")), o, ia);
+    render_whitted(still, *b, o, ib);
+    diff = 0;
+    for (std::size_t i = 0; i < ia.rgb.size(); ++i) diff = std::max(diff, double(std::fabs(ia.rgb[i] - ib.rgb[i])));
+    EXPECT_GT(diff, 0.05);
 }
 
 /// Distribution ray tracing of a moving scene converges to the average of
