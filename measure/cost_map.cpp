@@ -38,6 +38,8 @@ CostMap primary_ray_cost(const Scene& scene, const Accel& accel, int width, int 
             map.hit[i] = hit.found() ? 1 : 0;
         }
     });
+    if (!counted && !scene.moving_instances.empty())
+        throw std::runtime_error("traversal costs are not counted for scenes with motion (the motion BVH does not count)");
     if (!counted)
         throw std::runtime_error(accel.stats().name + " cannot count its traversal steps; choose another structure");
     if (!map.cost.empty()) {

@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <array>
 #include <bit>
-#include <stdexcept>
-#include <type_traits>
+#include <cassert>
 #include <cmath>
+#include <stdexcept>
 
 #include "accel/accel.h"
 #include "accel/packet_intersector.h"
@@ -40,8 +40,6 @@ constexpr int kPacket = 4;
 #else
 constexpr int kPacket = 1;
 #endif
-
-
 
 float motion_cost(const Box3f& start, const Box3f& end) { return 0.5f * (start.half_area() + end.half_area()); }
 
@@ -126,6 +124,7 @@ std::uint32_t MotionBvh::collapse(std::uint32_t node) {
     }
     for (int j = 0; j < count; ++j) {
         const Node& c = nodes_[kids[j]];
+        assert(c.count <= kMaxLeaf);  // a leaf's count has 3 bits
         const std::uint32_t code = c.count > 0 ? kLeaf | c.first << 3 | c.count : collapse(kids[j]);
         wide_[index].child[j] = code;
     }
