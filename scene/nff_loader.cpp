@@ -532,6 +532,7 @@ private:
             return;
         }
         end.m[0][3] += move_.x, end.m[1][3] += move_.y, end.m[2][3] += move_.z;
+        if (!end.finite()) fail(entity_line_, "the 'move' in force takes the placement past the float range" + where());
         if (end == m) {
             scene_.add_instance(k, m, scene_);
         } else {

@@ -134,6 +134,8 @@ TEST(Motion, BadMotionIsAClearError) {
          "passes through a singular matrix at shutter fraction 0.5"},
         {"begin a\ns 0 0 0 1\nend\ninst a 1 0 0 0 0 1 0 0 0 0 1 0 1 0 0 0 0 0 0 0 0 0 1 0\n", 4,
          "singular instance matrix"},
+        {"move 3e38 0 0\nbegin a\ns 0 0 0 1\nend\ninst a 1 0 0 3e38 0 1 0 0 0 0 1 0\n", 5,
+         "takes the placement past the float range"},
     };
     expect_scene_errors(cases);
 }
