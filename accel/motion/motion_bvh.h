@@ -4,7 +4,8 @@
 // opening and one at its closing; a ray at shutter fraction s tests the
 // four boxes interpolated at s in SIMD lanes. This is Embree's linear
 // motion BVH (BVH4MB, Woop et al. 2017, "Embree ray tracing kernels:
-// overview and new features"), built as a binary SAH tree and collapsed. Linear bounds rather than time-segmented nodes: each
+// overview and new features"), built as a binary SAH tree and collapsed.
+// Linear bounds rather than time-segmented nodes: each
 // placement here moves along one linear segment (NFF `move`, or `inst`
 // with two matrices), every point of it on a straight line, so the
 // interpolated end boxes hold it at every time and one tree serves the
@@ -43,9 +44,10 @@ public:
     bool occluded(const Rayf& ray, float s) const;
 
     /// The same for a batch of rays with their fractions, traced as packets
-    /// of kPacket rays (each lane at its own time) down the tree: a node's
-    /// boxes are fetched once per packet, and its four children tested for
-    /// all the packet's lanes in SIMD; items are tested lane by lane.
+    /// (16 lanes with AVX-512, each lane at its own time) down the tree: a
+    /// node's four children are tested for all the packet's lanes in SIMD,
+    /// a primitive item for all its lanes in one K x 1 kernel call; lanes
+    /// left alone go on ray by ray.
     void intersect(std::span<const Rayf> rays, std::span<const float> fractions, std::span<Hitf> hits) const;
     /// occluded[i] is set to 1 where a moving placement blocks ray i (it
     /// is left as it is elsewhere).
