@@ -1,6 +1,8 @@
 // raypack rays SCENE --kind camera|shadow|diffuse [--res W H] [--seed S] [--offset POLICY] -o FILE.rays
 // Writes the ray sets the benchmarks and the Embree comparison trace.
+#include <cmath>
 #include <cstdio>
+#include <stdexcept>
 
 #include "app/scene_options.h"
 #include "app/commands.h"
@@ -51,6 +53,13 @@ int run_rays(const Args& args) {
     } else {
         throw UsageError("--kind: expected camera, shadow or diffuse, got '" + kind + "'");
     }
+    // The readers refuse what they cannot trace; so does the writer, rather
+    // than leave a file no tracer reads (coordinates near the float range
+    // give offsets and directions that overflow).
+    for (std::size_t i = 0; i < rays.size(); ++i)
+        if (!all_finite(rays[i].org) || !all_finite(rays[i].dir) || std::isnan(rays[i].tnear) || std::isnan(rays[i].tfar))
+            throw std::runtime_error(p.positional()[0] + ": " + kind + " ray " + std::to_string(i) +
+                                     " is not finite (the scene's coordinates overflow float); nothing written");
     write_rays(p.text("--output"), file_kind, rays, times);
     std::printf("wrote %zu %s rays%s to %s\n", rays.size(), kind.c_str(),
                 times.empty() ? "" : " (with times over the shutter)", p.text("--output").c_str());

@@ -274,6 +274,18 @@ TEST(Cli, BadInputNamesTheFileAndLeavesOutputsAlone) {
     const Result rays = run("trace gen:tetra:1 --rays " + junk.string());
     EXPECT_EQ(rays.status, 1);
     EXPECT_NE(rays.output.find("junk.rays"), std::string::npos) << rays.output;
+
+    // A scene at the edge of the float range: its shadow rays overflow, and
+    // `rays` says so instead of writing a file no reader takes.
+    const fs::path huge = dir / "huge.nff";
+    { std::ofstream(huge) << "v from 0 -6 2 at 0 0 0 up 0 0 1 angle 40 hither 0.01 resolution 8 8\nl 4 -4 6\n"
+                             "s 0 0 0 3e38\n"; }
+    const fs::path set = dir / "set.rays";
+    { std::ofstream(set) << "previous rays"; }
+    const Result overflow = run("rays " + huge.string() + " --kind shadow -o " + set.string());
+    EXPECT_EQ(overflow.status, 1) << overflow.output;
+    EXPECT_NE(overflow.output.find("is not finite"), std::string::npos) << overflow.output;
+    EXPECT_EQ(slurp(set), "previous rays");
 }
 
 }  // namespace
