@@ -241,8 +241,8 @@ HitInPlacement hit_in_placement(const Scene& scene, const Rayf& ray, const Hitf&
     Hitf h = hit;
     h.prim -= inst.first_hit_id;
     HitInPlacement in{&inst, inst.to_world, inst.to_object, {}, h};
-    if (!scene.moving_instances.empty() && &inst >= scene.moving_instances.data() &&
-        &inst < scene.moving_instances.data() + scene.moving_instances.size()) {
+    // Moving placements' ids follow the static ones' (instance_of_hit_id).
+    if (!scene.moving_instances.empty() && hit.prim >= scene.moving_instances.front().first_hit_id) {
         const float s = scene.shutter_fraction(time);
         in.to_world = inst.to_world_at(s);
         in.to_object = inst.to_object_at(s);
