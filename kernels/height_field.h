@@ -91,6 +91,9 @@ inline void HeightField::build_ranges() {
         level_h.push_back(h);
         level_offset.push_back(std::uint32_t(base));
     }
+    // The lane walk holds the level tables in 32 lanes (height_field_walk.h):
+    // fields up to 2^31 cells a side.
+    if (level_offset.size() > 32) throw std::length_error("height field pyramid deeper than 32 levels");
 }
 
 /// Where field position (u, v) in [0, 1]^2 lies: cell (i, j), at (s, r) in

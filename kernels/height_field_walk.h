@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <limits>
 
+#include "kernels/gather.h"
 #include "kernels/height_field.h"
 #include "kernels/ray.h"
 #include "kernels/simd.h"
@@ -206,7 +207,7 @@ RAYPACK_INLINE F vmax_like_std(const F& a, const F& b) {
 /// intersect_height_cell lane by lane, each lane its own cell (ix, iy) with
 /// its corner heights already read.
 template <class F>
-mask_of<F> height_cell_lanes(const HeightField& f, const F& ix, const F& iy, const F& h00, const F& h10, const F& h01,
+RAYPACK_INLINE mask_of<F> height_cell_lanes(const HeightField& f, const F& ix, const F& iy, const F& h00, const F& h10, const F& h01,
                              const F& h11, const Vec3<F>& org, const Vec3<F>& dir, const F& inv_dx, const F& inv_dy,
                              const F& tnear, const F& tfar, const F& t_lo, const F& t_hi, const F& dz, F& t, F& u,
                              F& v) {
@@ -310,6 +311,16 @@ mask_of<F> intersect_height_field_lanes(const HeightField& f, mask_of<F> active,
     const auto* level_w = reinterpret_cast<const std::int32_t*>(f.level_w.data());
     const auto* level_offset = reinterpret_cast<const std::int32_t*>(f.level_offset.data());
     const F top_scale = F(float(1u << top));
+    // The level tables in lanes (build_ranges keeps pyramids to 32
+    // levels), looked up by a permute instead of two dependent gathers per
+    // step.
+    alignas(64) std::int32_t offset_table[32] = {}, width_table[32] = {};
+    for (int k = 0; k <= top; ++k) {
+        offset_table[k] = level_offset[k];
+        width_table[k] = level_w[k];
+    }
+    const I offset_lo = I::load_aligned(offset_table), offset_hi = I::load_aligned(offset_table + 16);
+    const I width_lo = I::load_aligned(width_table), width_hi = I::load_aligned(width_table + 16);
     // scale = 2^level and its reciprocal, kept exact by halving and doubling.
     F t = t0, level = F(float(top)), scale = top_scale, inv_scale = one / top_scale;
     M hit(false);
@@ -324,27 +335,29 @@ mask_of<F> intersect_height_field_lanes(const HeightField& f, mask_of<F> active,
         const F texit = vmin_like_std(vmin_like_std(tx, ty), t1);
         // The block's heights: its four samples at level 0, else the pyramid.
         const M at_cell = level == zero;
-        // Gathered only when some walking lane needs them: coherent lanes
-        // are mostly at one level.
+        // Gathered only when some walking lane needs them (coherent lanes
+        // are mostly at one level), and only in those lanes: a gather costs
+        // by the element, and a branch that skips it pays (not so a
+        // branch-free walk with both gathers masked: 1.3x slower).
         F zmin(0.0f), zmax(0.0f), h00(0.0f), h10(0.0f), h01(0.0f), h11(0.0f);
-        if (any(active & at_cell)) {
+        if (const M need = active & at_cell; any(need)) {
             const I s00 = xsimd::batch_cast<std::int32_t>(iy) * nx_i + xsimd::batch_cast<std::int32_t>(ix);
-            h00 = F::gather(samples, s00);
-            h10 = F::gather(samples, s00 + I(1));
-            h01 = F::gather(samples, s00 + nx_i);
-            h11 = F::gather(samples, s00 + nx_i + I(1));
+            h00 = gather_floats<F>(samples, s00, need);
+            h10 = gather_floats<F>(samples, s00 + I(1), need);
+            h01 = gather_floats<F>(samples, s00 + nx_i, need);
+            h11 = gather_floats<F>(samples, s00 + nx_i + I(1), need);
             zmin = vmin_like_std(vmin_like_std(h00, h10), vmin_like_std(h01, h11));
             zmax = vmax_like_std(vmax_like_std(h00, h10), vmax_like_std(h01, h11));
         }
-        if (top > 0 && any(active & !at_cell)) {
-            // Level-0 lanes read level 1's table and pair 0 (any valid entry) and ignore it.
+        if (const M need = active & !at_cell; top > 0 && any(need)) {
+            // Level-0 lanes look up level 1 (any valid level) and read nothing.
             const I cell_bits = xsimd::bitwise_cast<I>(xsimd::bitwise_cast(at_cell));
             const I lc = l | (cell_bits & I(1));
-            const I pidx = (I::gather(level_offset, lc) + (xsimd::batch_cast<std::int32_t>(ay) * I::gather(level_w, lc) +
-                                                           xsimd::batch_cast<std::int32_t>(ax)) * I(2)) &
-                           ~cell_bits;
-            zmin = select(at_cell, zmin, F::gather(f.range.data(), pidx));
-            zmax = select(at_cell, zmax, F::gather(f.range.data(), pidx + I(1)));
+            const I offset = lookup32(offset_table, offset_lo, offset_hi, lc);
+            const I width = lookup32(width_table, width_lo, width_hi, lc);
+            const I pidx = offset + (xsimd::batch_cast<std::int32_t>(ay) * width + xsimd::batch_cast<std::int32_t>(ax)) * I(2);
+            zmin = select(at_cell, zmin, gather_floats<F>(f.range.data(), pidx, need));
+            zmax = select(at_cell, zmax, gather_floats<F>(f.range.data(), pidx + I(1), need));
         }
         const F za = org.z + t * dir.z, zb = org.z + texit * dir.z;
         const F margin =
