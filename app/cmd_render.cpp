@@ -179,6 +179,10 @@ int run_render(const Args& args) {
     const std::string output = p.has("--output") ? p.text("--output") : default_output(scene_spec);
     const std::string aov = p.text("--aov");
     if (p.has("--aov") && aov != "cost") throw UsageError("--aov: expected cost, got '" + aov + "'");
+    // The image module loads on the other core while the scene loads and the
+    // structure builds: started later, it took a core from the render's
+    // second thread (a 2-thread tetra render ran no faster than 1 thread).
+    start_loading_image_module(output);
 
     auto t0 = std::chrono::steady_clock::now();
     const Scene scene = load_scene_from(p, scene_spec);
@@ -191,6 +195,12 @@ int run_render(const Args& args) {
     require_memory(std::uint64_t(options.width) * std::uint64_t(options.height) * (options.distribution ? 28 : 12),
                    "a " + std::to_string(options.width) + " x " + std::to_string(options.height) + " image");
 
+    // The image a Whitted render writes pixel by pixel, made before the
+    // build: its fresh pages cost several ms to fault in on this project's
+    // virtual machines, which is not rendering (render_ms), and which the
+    // second thread cannot share (docs/renderer.md, "Threads").
+    Image image;
+    if (integrator == "whitted" && aov != "cost") image = Image(options.width, options.height);
     const auto accel = build_accel(scene, config);
     if (aov == "cost") return render_cost(scene, *accel, options.width, options.height, output);
     options.packet = fastest ? supported_packet(*accel, fastest_config(RayWorkload::Camera).packet)
@@ -202,8 +212,6 @@ int run_render(const Args& args) {
     ProgressLine progress(!json && !quiet && ::isatty(STDOUT_FILENO));
     options.progress = &ProgressLine::report;
     options.progress_context = &progress;
-    start_loading_image_module(output);  // past the likely errors: the image module loads while tracing
-    Image image;
     const RenderStats stats = integrator == "path" ? render_path(scene, *accel, options, path, image)
                                                    : render_whitted(scene, *accel, options, image);
     progress.finish();

@@ -32,6 +32,11 @@ void print_usage(std::FILE* out) {
 
 int main(int argc, char** argv) {
     raypack::app::reserve_heap_in_large_pages();
+    // Commands start loading their image module in the background
+    // (render/image.h): no way out of main leaves while it still loads.
+    struct WaitForImageModules {
+        ~WaitForImageModules() { raypack::wait_for_image_modules(); }
+    } wait_for_image_modules_on_exit;
     // NFF's `hf FILE`: heights from an image's first channel, through OpenImageIO.
     raypack::set_height_image_reader([](const std::string& path, std::uint32_t& w, std::uint32_t& h) {
         const raypack::Image image = raypack::read_image(path);

@@ -96,6 +96,11 @@ const RaypackImageModule& module_of(ModuleSlot& slot) {
 
 void start_loading_image_module(const std::string& path_to_write) { start_loading(writer_slot(path_to_write)); }
 
+void wait_for_image_modules() {
+    for (ModuleSlot* slot : {&g_oiio, &g_png})
+        if (slot->loaded.valid()) slot->loaded.wait();
+}
+
 void write_image(const std::string& path, const Image& image) {
     const RaypackImageModule& module = module_of(writer_slot(path));
     std::array<char, 1024> error{};

