@@ -12,6 +12,10 @@ the two renders' tracing overlaps in time despite their load and build.
   2T/1T    = render throughput at 2 threads / at 1 thread (rays / render_ms)
   ceiling  = (throughput of the pair's two renders, summed) / throughput alone
   2T/ceil  = how much of the machine's ceiling the renderer's threads reach
+  fastest  = the fastest 1-thread render time / the fastest 2-thread one: a
+             short render (tetra: 8 ms) loses a whole scheduler tick (4 ms)
+             whenever something else on the machine needs a core, which at 1
+             thread runs on the idle one
 
 usage: scripts/thread_scaling.py [--raypack build/raypack] [--rounds 5] [--ceiling-res 1024] [SCENE ...]
 """
@@ -38,9 +42,11 @@ def throughput(stdout):
     return sum(j["rays"].values()) - j["rays"]["eye_hits"], j["render_ms"]
 
 
-def run(cmd):
+def run(cmd, times=None):
     r = subprocess.run(cmd, capture_output=True, text=True, check=True)
     n, ms = throughput(r.stdout)
+    if times is not None:
+        times.append(ms)
     return n / ms
 
 
@@ -68,19 +74,19 @@ def main():
     out = [os.path.join(tmp, f"{k}.png") for k in range(2)]
     print(f"# {args.rounds} rounds, 2T/1T at 512 x 512, ceiling at {args.ceiling_res} x {args.ceiling_res}, "
           "medians of per-round ratios")
-    print("| scene | 2T/1T | ceiling (two 1T renders at once) | 2T/ceiling |")
-    print("|---|---|---|---|")
+    print("| scene | 2T/1T | ceiling (two 1T renders at once) | 2T/ceiling | fastest 1T / fastest 2T |")
+    print("|---|---|---|---|---|")
     for scene in args.scenes:
-        speedup, ceiling = [], []
+        speedup, ceiling, ms1, ms2 = [], [], [], []
         for _ in range(args.rounds):
-            one = run(command(args.raypack, scene, 1, out[0]))
-            two = run(command(args.raypack, scene, 2, out[0]))
+            one = run(command(args.raypack, scene, 1, out[0]), ms1)
+            two = run(command(args.raypack, scene, 2, out[0]), ms2)
             alone = run(command(args.raypack, scene, 1, out[0], args.ceiling_res))
             both = pair([command(args.raypack, scene, 1, out[k], args.ceiling_res) for k in range(2)])
             speedup.append(two / one)
             ceiling.append(both / alone)
         s, c = statistics.median(speedup), statistics.median(ceiling)
-        print(f"| {scene} | {s:.2f}x | {c:.2f}x | {s / c:.2f} |", flush=True)
+        print(f"| {scene} | {s:.2f}x | {c:.2f}x | {s / c:.2f} | {min(ms1) / min(ms2):.2f}x |", flush=True)
 
 
 if __name__ == "__main__":
