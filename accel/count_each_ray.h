@@ -2,8 +2,8 @@
 // Accel::count_traversal for the structures whose counting walk is their
 // own traversal with counters (grid, octree, k-d tree): each ray through
 // intersect_counting / occluded_counting, answers in the interface's form,
-// the structure's own counters mapped onto TraversalCounts (`nodes` names
-// the field that counts nodes or cells; every structure counts prim_tests).
+// the structure's own counters mapped onto TraversalCounts by their
+// `add_to`.
 #include <cstdint>
 #include <span>
 
@@ -12,9 +12,9 @@
 
 namespace raypack {
 
-template <class Structure, class Counters>
+template <class Counters, class Structure>
 bool count_each_ray(const Structure& s, std::span<const Rayf> rays, bool any_hit, std::span<Hitf> hits,
-                    TraversalCounts& counts, std::uint64_t Counters::*nodes) {
+                    TraversalCounts& counts) {
     Counters counters;
     for (std::size_t i = 0; i < rays.size(); ++i) {
         if (!any_hit) {
@@ -24,8 +24,7 @@ bool count_each_ray(const Structure& s, std::span<const Rayf> rays, bool any_hit
         hits[i] = Hitf{};
         if (s.occluded_counting(rays[i], counters)) hits[i].prim = 0;  // found() = occluded
     }
-    counts.nodes += counters.*nodes;
-    counts.prims += counters.prim_tests;
+    counters.add_to(counts);
     return true;
 }
 

@@ -124,7 +124,7 @@ void validate_against_oracle(const Accel& accel, int packet, const BenchRays& se
 std::optional<WorkPerRay> work_per_ray(const Accel& accel, const BenchRays& set, std::size_t max_rays) {
     const std::vector<std::size_t> index = sample_positions(set.rays.size(), max_rays, kBatch);
     const std::vector<Rayf> rays = gather(set.rays, index);
-    std::atomic<std::uint64_t> nodes{0}, prims{0};
+    std::atomic<std::uint64_t> nodes{0}, prims{0}, leaves{0}, empty_leaves{0};
     std::atomic<bool> available{true};
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), kBatch), [&](const auto& r) {
         std::vector<Hitf> hits(r.size());
@@ -133,9 +133,12 @@ std::optional<WorkPerRay> work_per_ray(const Accel& accel, const BenchRays& set,
             available = false;
         nodes += c.nodes;
         prims += c.prims;
+        leaves += c.leaves;
+        empty_leaves += c.empty_leaves;
     });
     if (!available || rays.empty()) return std::nullopt;
-    return WorkPerRay{double(nodes) / double(rays.size()), double(prims) / double(rays.size())};
+    const double n = double(rays.size());
+    return WorkPerRay{double(prims) / n, double(nodes) / n, double(leaves) / n, double(empty_leaves) / n};
 }
 
 std::vector<double> time_passes(const Accel& accel, int packet, const BenchRays& set, int repeat,

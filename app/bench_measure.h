@@ -45,11 +45,11 @@ OracleSample oracle_sample(const Scene& scene, const BenchRays& set, std::size_t
 void validate_against_oracle(const Accel& accel, int packet, const BenchRays& set, const OracleSample& sample,
                              const std::string& context);
 
-/// Nodes and primitive tests per ray over a deterministic sample of up to
-/// `max_rays` rays (single-ray counting walks, in parallel); empty when the
-/// structure cannot count.
+/// Havran's measures per ray (accel/traversal_counts.h) over a
+/// deterministic sample of up to `max_rays` rays (single-ray counting walks,
+/// in parallel); empty when the structure cannot count.
 struct WorkPerRay {
-    double nodes = 0, prims = 0;
+    double n_it = 0, n_ts = 0, n_ets = 0, n_eets = 0;
 };
 std::optional<WorkPerRay> work_per_ray(const Accel& accel, const BenchRays& set, std::size_t max_rays);
 

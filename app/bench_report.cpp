@@ -42,8 +42,8 @@ nlohmann::ordered_json to_json(const BenchRow& r) {
     j["mrays_per_s_min"] = r.mrays_per_s_min;
     j["mrays_per_s_max"] = r.mrays_per_s_max;
     j["trace_ms_median"] = r.trace_ms_median;
-    j["nodes_per_ray"] = r.nodes_per_ray ? nlohmann::ordered_json(*r.nodes_per_ray) : nlohmann::ordered_json();
-    j["prims_per_ray"] = r.prims_per_ray ? nlohmann::ordered_json(*r.prims_per_ray) : nlohmann::ordered_json();
+    for (const auto& [name, value] : {std::pair{"n_it", r.n_it}, {"n_ts", r.n_ts}, {"n_ets", r.n_ets}, {"n_eets", r.n_eets}})
+        j[name] = value ? nlohmann::ordered_json(*value) : nlohmann::ordered_json();
     j["hits"] = r.hits;
     j["validated_rays"] = r.validated_rays;
     j["validated"] = r.validated;
@@ -53,17 +53,18 @@ nlohmann::ordered_json to_json(const BenchRow& r) {
 }  // namespace
 
 void print_bench_header(std::FILE* out) {
-    std::fprintf(out, "%-8s %-7s %2s %-8s %3s %9s %10s %9s %9s %19s %9s %9s\n", "scene", "accel", "K", "rays", "thr",
-                 "build ms", "memory", "SAH cost", "Mrays/s", "(min - max)", "nodes/ray", "prims/ray");
+    std::fprintf(out, "%-8s %-7s %2s %-8s %3s %9s %10s %9s %9s %19s %7s %7s %7s %7s\n", "scene", "accel", "K", "rays",
+                 "thr", "build ms", "memory", "SAH cost", "Mrays/s", "(min - max)", "N_IT", "N_TS", "N_ETS", "N_EETS");
 }
 
 void print_bench_row(std::FILE* out, const BenchRow& r) {
     char spread[32];
     std::snprintf(spread, sizeof spread, "(%.2f - %.2f)", r.mrays_per_s_min, r.mrays_per_s_max);
-    std::fprintf(out, "%-8s %-7s %2d %-8s %3d %9.1f %10s %9s %9.2f %19s %9s %9s\n", r.scene.c_str(), r.accel.c_str(),
-                 r.packet, r.rays.c_str(), r.threads, r.build_ms, format_bytes(r.memory_bytes).c_str(),
+    std::fprintf(out, "%-8s %-7s %2d %-8s %3d %9.1f %10s %9s %9.2f %19s %7s %7s %7s %7s\n", r.scene.c_str(),
+                 r.accel.c_str(), r.packet, r.rays.c_str(), r.threads, r.build_ms, format_bytes(r.memory_bytes).c_str(),
                  r.sah_cost > 0 ? format_optional(r.sah_cost, "%.1f").c_str() : "-", r.mrays_per_s_median, spread,
-                 format_optional(r.nodes_per_ray, "%.1f").c_str(), format_optional(r.prims_per_ray, "%.1f").c_str());
+                 format_optional(r.n_it, "%.1f").c_str(), format_optional(r.n_ts, "%.1f").c_str(),
+                 format_optional(r.n_ets, "%.1f").c_str(), format_optional(r.n_eets, "%.2f").c_str());
 }
 
 void write_bench_json(const std::string& path, const std::vector<BenchRow>& rows) {

@@ -23,7 +23,10 @@ struct BenchRow {
     double sah_cost = 0;      ///< the structure's quality figure (0 where it means nothing)
     double mrays_per_s_median = 0, mrays_per_s_min = 0, mrays_per_s_max = 0;
     double trace_ms_median = 0;
-    std::optional<double> nodes_per_ray, prims_per_ray;  ///< empty where the structure cannot count
+    /// Per ray, Havran's measures (accel/traversal_counts.h): intersection
+    /// tests, traversal steps, leaves or cells entered, empty ones among
+    /// them; empty where the structure cannot count (Embree).
+    std::optional<double> n_it, n_ts, n_ets, n_eets;
     std::size_t hits = 0;     ///< closest hits found, or occluded rays
     std::size_t validated_rays = 0;
     bool validated = false;

@@ -287,7 +287,12 @@ int run_bench(const Args& args) {
                         row.mrays_per_s_median = row.trace_ms_median > 0 ? mrays / row.trace_ms_median : 0;
                         row.mrays_per_s_min = mrays / *std::max_element(ms.begin(), ms.end());
                         row.mrays_per_s_max = mrays / std::max(1e-9, *std::min_element(ms.begin(), ms.end()));
-                        if (work) row.nodes_per_ray = work->nodes, row.prims_per_ray = work->prims;
+                        if (work) {
+                            row.n_it = work->n_it;
+                            row.n_ts = work->n_ts;
+                            row.n_ets = work->n_ets;
+                            row.n_eets = work->n_eets;
+                        }
                         row.validated_rays = samples[s].rays.size();
                         row.validated = true;
                         print_bench_row(stdout, row);

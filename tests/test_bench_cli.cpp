@@ -51,10 +51,11 @@ std::string first_line(const fs::path& p) {
     return line;
 }
 
-const char* const kRequiredFields[] = {"scene",           "accel",           "packet",          "rays",
+const char* const kRequiredFields[] = {"scene",           "accel",           "packet",       "rays",
                                        "threads",         "build_ms",        "mrays_per_s_median",
-                                       "mrays_per_s_min", "mrays_per_s_max", "nodes_per_ray",
-                                       "prims_per_ray",   "memory_bytes",    "validated"};
+                                       "mrays_per_s_min", "mrays_per_s_max", "n_it",
+                                       "n_ts",            "n_ets",           "n_eets",       "memory_bytes",
+                                       "validated"};
 
 TEST(BenchCli, QuickRunValidatesEveryStructureWidthAndRayKind) {
     const fs::path json = temp_dir() / "quick.json", csv = temp_dir() / "quick.csv";
@@ -77,9 +78,23 @@ TEST(BenchCli, QuickRunValidatesEveryStructureWidthAndRayKind) {
         EXPECT_LE(row["mrays_per_s_median"].get<double>(), row["mrays_per_s_max"].get<double>()) << row.dump();
         const std::string accel = row["accel"];
         if (is_embree_kind(accel)) {
-            EXPECT_TRUE(row["nodes_per_ray"].is_null()) << "Embree cannot count";
-        } else {
-            EXPECT_GT(row["prims_per_ray"].get<double>(), 0.0) << row.dump();
+            for (const char* m : {"n_it", "n_ts", "n_ets", "n_eets"}) EXPECT_TRUE(row[m].is_null()) << "Embree cannot count";
+        } else if (accel != "brute") {
+            // Havran's measures: every elementary cell is a traversal step,
+            // empty cells are elementary cells; a BVH has no empty leaves,
+            // and a grid's traversal steps are its cells.
+            const double it = row["n_it"], ts = row["n_ts"], ets = row["n_ets"], eets = row["n_eets"];
+            EXPECT_GT(it, 0.0) << row.dump();
+            EXPECT_GT(ets, 0.0) << row.dump();
+            EXPECT_LE(ets, ts) << row.dump();
+            EXPECT_LE(eets, ets) << row.dump();
+            if (accel.rfind("bvh", 0) == 0) {
+                EXPECT_EQ(eets, 0.0) << row.dump();
+            }
+            if (accel == "grid") {
+                EXPECT_EQ(ets, ts) << row.dump();
+                EXPECT_GT(eets, 0.0) << "the SPD balls grid has empty cells on every ray kind: " << row.dump();
+            }
         }
         accels.insert(accel);
         kinds.insert(row["rays"].get<std::string>());

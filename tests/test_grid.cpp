@@ -421,7 +421,11 @@ TEST_F(Grid, CountingModeAgreesAndCounts) {
     GridRayCounters row;
     EXPECT_FALSE(sparse->intersect_counting(r, row).found());
     EXPECT_EQ(row.cells_visited, std::uint64_t(g.res[0]));
+    EXPECT_EQ(row.empty_cells_visited, std::uint64_t(g.res[0]));
     EXPECT_EQ(row.prim_tests, 0u);
+    // The teapot's rays crossed empty cells and others.
+    EXPECT_GT(c.empty_cells_visited, 0u);
+    EXPECT_LT(c.empty_cells_visited, c.cells_visited);
     // A ray that misses the grid visits none.
     r.org = {-1, 5, 5};
     GridRayCounters none;

@@ -615,6 +615,10 @@ TEST_F(KdTree, CountingModeAgreesAndCounts) {
     EXPECT_FALSE(sparse->intersect_counting(r, between).found());
     EXPECT_GT(between.nodes_visited, 0u);
     EXPECT_EQ(between.prim_tests, 0u);
+    EXPECT_GT(between.leaves_visited, 0u);
+    EXPECT_EQ(between.empty_leaves_visited, between.leaves_visited);  // only empty space between them
+    EXPECT_GT(c.empty_leaves_visited, 0u);  // the teapot's tree has empty leaves its rays cross
+    EXPECT_LT(c.empty_leaves_visited, c.leaves_visited);
     r.org = {-1, 5, 5};
     KdRayCounters none;
     EXPECT_FALSE(sparse->intersect_counting(r, none).found());

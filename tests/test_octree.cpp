@@ -606,6 +606,13 @@ TEST_F(Octree, CountingModeAgreesAndCounts) {
     EXPECT_FALSE(sparse->intersect_counting(r, row).found());
     EXPECT_EQ(row.prim_tests, 0u);
     EXPECT_EQ(row.nodes_visited, 3u);  // root, then children (lower y, upper z): lower x, upper x
+    EXPECT_EQ(row.empty_leaves_visited, 2u);  // neither holds a sphere
+    TraversalCounts havran;
+    row.add_to(havran);
+    EXPECT_EQ(havran.nodes, 3u);  // N_TS
+    EXPECT_EQ(havran.leaves, 2u);  // N_ETS
+    EXPECT_EQ(havran.empty_leaves, 2u);  // N_EETS
+    EXPECT_EQ(havran.prims, 0u);  // N_IT
     // A ray that misses the cube visits nothing.
     r.org = {-1, 5, 5};
     OctreeRayCounters none;

@@ -56,6 +56,20 @@ void expect_same_answers(const std::string& kind, const std::string& scene_spec)
     if (kind != "brute") {
         EXPECT_GT(closest.nodes, 0u) << kind;
         EXPECT_LT(closest.prims, rays.size() * scene.primitive_count() / 4) << kind << " tests too many primitives";
+        // Havran's measures nest: N_EETS <= N_ETS <= N_TS; a BVH has no
+        // empty leaves, a grid's steps are all cells, and the rays from
+        // inside the box all enter some leaf.
+        for (const TraversalCounts& c : {closest, any}) {
+            EXPECT_GT(c.leaves, 0u) << kind;
+            EXPECT_LE(c.leaves, c.nodes) << kind;
+            EXPECT_LE(c.empty_leaves, c.leaves) << kind;
+            if (kind.rfind("bvh", 0) == 0) {
+                EXPECT_EQ(c.empty_leaves, 0u) << kind;
+            }
+            if (kind == "grid") {
+                EXPECT_EQ(c.leaves, c.nodes);
+            }
+        }
     } else {
         EXPECT_EQ(closest.prims, rays.size() * scene.primitive_count());
     }

@@ -52,6 +52,7 @@ inline bool trace_bvh2_subtree(const Bvh2& bvh, const PrimitiveIntersector<float
         count.node();
         const Bvh2Node& node = nodes[current];
         if (node.is_leaf()) {
+            count.leaf();
             for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
                 count.prim();
                 if (isect.intersect(bvh.prim_index[k], ray, hit)) {

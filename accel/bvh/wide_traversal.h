@@ -105,6 +105,7 @@ RAYPACK_INLINE bool intersect_leaf(const WideBvh<N, M>& bvh, SphereMethod sm, st
                                    const LeafRay<vfloat<M>>& r, const PrimLeafRay* by_prim, float& tfar, Hitf& hit,
                                    Count& count) {
     count.node();
+    count.leaf();
     return bvh.template for_each_run<AnyHit, Kinds>(code, [&]<class Kind>(const auto* blocks, std::uint32_t n)
                                                         RAYPACK_INLINE_LAMBDA {
         if constexpr (ByPrim) return intersect_run_by_prim<AnyHit>(blocks, n, *by_prim, tfar, hit, count);

@@ -82,9 +82,12 @@ bool GridAccel::trace(Rayf& ray, Hitf& hit, GridRayCounters* counters) const {
         do {
             seg = dda.next();
             if (!seg) return found;
-            if constexpr (Counting) ++counters->cells_visited;
             first = begin[seg->cell];
             last = begin[seg->cell + 1];
+            if constexpr (Counting) {
+                ++counters->cells_visited;
+                counters->empty_cells_visited += first == last;
+            }
         } while (first == last && !(seg->t_exit > ray.tfar));
         for (std::uint32_t k = first; k < last; ++k) {
             const std::uint32_t prim = refs[k];
@@ -144,7 +147,7 @@ bool GridAccel::occluded_counting(const Rayf& ray_in, GridRayCounters& counters)
 
 bool GridAccel::count_traversal(std::span<const Rayf> rays, bool any_hit, std::span<Hitf> hits,
                                 TraversalCounts& counts) const {
-    return count_each_ray(*this, rays, any_hit, hits, counts, &GridRayCounters::cells_visited);
+    return count_each_ray<GridRayCounters>(*this, rays, any_hit, hits, counts);
 }
 
 bool GridAccel::supports_packet(int width) const {

@@ -12,9 +12,17 @@ namespace raypack {
 /// Per-ray work, gathered by the counting traversal only.
 struct GridRayCounters {
     std::uint64_t rays = 0;
-    std::uint64_t cells_visited = 0;  ///< cells the DDA yielded, empty ones included
-    std::uint64_t prim_tests = 0;     ///< ray-primitive tests run
-    std::uint64_t mailbox_skips = 0;  ///< repeated tests the mailbox avoided
+    std::uint64_t cells_visited = 0;        ///< cells the DDA yielded, empty ones included
+    std::uint64_t empty_cells_visited = 0;  ///< of which empty
+    std::uint64_t prim_tests = 0;           ///< ray-primitive tests run
+    std::uint64_t mailbox_skips = 0;        ///< repeated tests the mailbox avoided
+    /// Havran's measures: a grid's traversal steps are its cells.
+    void add_to(TraversalCounts& c) const {
+        c.nodes += cells_visited;
+        c.leaves += cells_visited;
+        c.empty_leaves += empty_cells_visited;
+        c.prims += prim_tests;
+    }
 };
 
 class GridAccel final : public Accel {

@@ -127,6 +127,7 @@ bool KdTreeAccel::trace(Rayf& ray, Hitf& hit, KdRayCounters* counters) const {
         const std::uint32_t count = node.prim_count();
         if constexpr (Counting) {
             ++counters->leaves_visited;
+            counters->empty_leaves_visited += count == 0;
             counters->prim_tests += count;
         }
         const std::uint32_t* prims = tree_.leaf_prims(nodes[current]);
@@ -199,7 +200,7 @@ bool KdTreeAccel::occluded_counting(const Rayf& ray_in, KdRayCounters& counters)
 
 bool KdTreeAccel::count_traversal(std::span<const Rayf> rays, bool any_hit, std::span<Hitf> hits,
                                   TraversalCounts& counts) const {
-    return count_each_ray(*this, rays, any_hit, hits, counts, &KdRayCounters::nodes_visited);
+    return count_each_ray<KdRayCounters>(*this, rays, any_hit, hits, counts);
 }
 
 bool KdTreeAccel::supports_packet(int width) const {

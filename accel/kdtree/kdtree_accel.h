@@ -12,9 +12,16 @@ namespace raypack {
 /// Per-ray work, gathered by the counting traversal only.
 struct KdRayCounters {
     std::uint64_t rays = 0;
-    std::uint64_t nodes_visited = 0;   ///< inner nodes and leaves
-    std::uint64_t leaves_visited = 0;  ///< empty ones included
-    std::uint64_t prim_tests = 0;      ///< ray-primitive tests run
+    std::uint64_t nodes_visited = 0;         ///< inner nodes and leaves
+    std::uint64_t leaves_visited = 0;        ///< empty ones included
+    std::uint64_t empty_leaves_visited = 0;  ///< of which empty
+    std::uint64_t prim_tests = 0;            ///< ray-primitive tests run
+    void add_to(TraversalCounts& c) const {
+        c.nodes += nodes_visited;
+        c.leaves += leaves_visited;
+        c.empty_leaves += empty_leaves_visited;
+        c.prims += prim_tests;
+    }
 };
 
 class KdTreeAccel final : public Accel {

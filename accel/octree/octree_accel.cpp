@@ -125,7 +125,10 @@ bool OctreeAccel::trace(Rayf& ray, Hitf& hit, OctreeRayCounters* counters) const
         }
         f.child = revelles::new_node(c, c1[0], c1[1], c1[2]);
         const OctreeNode node = nodes[f.children + (unsigned(c) ^ a)];
-        if constexpr (Counting) ++counters->nodes_visited;
+        if constexpr (Counting) {
+            ++counters->nodes_visited;
+            counters->empty_leaves_visited += node.count == 0;
+        }
         if (node.count == 0) continue;  // an empty leaf
         const float child_exit = std::min({c1[0], c1[1], c1[2]});
         if (child_exit < ray.tnear) continue;  // behind the ray's start (rounding only: first_node skips these)
@@ -185,7 +188,7 @@ bool OctreeAccel::occluded_counting(const Rayf& ray_in, OctreeRayCounters& count
 
 bool OctreeAccel::count_traversal(std::span<const Rayf> rays, bool any_hit, std::span<Hitf> hits,
                                   TraversalCounts& counts) const {
-    return count_each_ray(*this, rays, any_hit, hits, counts, &OctreeRayCounters::nodes_visited);
+    return count_each_ray<OctreeRayCounters>(*this, rays, any_hit, hits, counts);
 }
 
 bool OctreeAccel::supports_packet(int width) const {

@@ -11,9 +11,16 @@ namespace raypack {
 /// Per-ray work, gathered by the counting traversal only.
 struct OctreeRayCounters {
     std::uint64_t rays = 0;
-    std::uint64_t nodes_visited = 0;   ///< nodes entered, inner and leaves (empty ones included)
-    std::uint64_t leaves_visited = 0;  ///< non-empty leaves whose primitives were tested
-    std::uint64_t prim_tests = 0;      ///< ray-primitive tests run
+    std::uint64_t nodes_visited = 0;         ///< nodes entered, inner and leaves (empty ones included)
+    std::uint64_t leaves_visited = 0;        ///< non-empty leaves whose primitives were tested
+    std::uint64_t empty_leaves_visited = 0;  ///< empty leaves entered
+    std::uint64_t prim_tests = 0;            ///< ray-primitive tests run
+    void add_to(TraversalCounts& c) const {
+        c.nodes += nodes_visited;
+        c.leaves += leaves_visited + empty_leaves_visited;
+        c.empty_leaves += empty_leaves_visited;
+        c.prims += prim_tests;
+    }
 };
 
 class OctreeAccel final : public Accel {
