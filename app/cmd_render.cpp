@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <mutex>
+#include <optional>
+#include <stdexcept>
 
 #include <nlohmann/json.hpp>
 #include <unistd.h>
@@ -13,6 +15,7 @@
 #include "app/default_config.h"
 #include "app/commands.h"
 #include "app/variant_options.h"
+#include "accel/counting_accel.h"
 #include "measure/cost_map.h"
 #include "render/path_tracer.h"
 #include "render/whitted.h"
@@ -100,7 +103,7 @@ int run_render(const Args& args) {
                              {"--quiet", "-q", 0}, {"--integrator", "", 1}, {"--spp", "", 1}, {"--sampler", "", 1},
                              {"--seed", "", 1}, {"--light-samples", "", 1}, {"--filter", "", 1},
                              {"--rr-depth", "", 1}, {"--exposure", "", 1}, {"--adaptive", "", 1},
-                             {"--adaptive-depth", "", 1}});
+                             {"--adaptive-depth", "", 1}, {"--counts", "", 0}});
     for (OptionSpec& k : scene_option_specs()) spec.push_back(std::move(k));
     const ParsedArgs p(args, spec, 1);
     if (p.help() || p.positional().empty()) {
@@ -128,6 +131,9 @@ int run_render(const Args& args) {
             "  --filter box|tent|gaussian  pixel filter (default box)\n"
             "  --seed S      random numbers of the samplers (default 1)\n"
             "  --exposure E  multiply the image by E before writing it (default 1)\n"
+            "  --counts      trace every ray through the structure's counting walk (slower, the same\n"
+            "                image) and report Havran's measures per ray over all the render's rays:\n"
+            "                N_IT tests, N_TS traversal steps, N_ETS leaves or cells, N_EETS empty ones\n"
             "  --json        print one JSON line (times, ray counts, Mrays/s) instead of the text report\n"
             "  --quiet, -q   print nothing on success\n"
             "  A progress line is shown on a terminal for renders that take more than a second.\n%s",
@@ -201,8 +207,20 @@ int run_render(const Args& args) {
     // second thread cannot share (docs/renderer.md, "Threads").
     Image image;
     if (integrator == "whitted" && aov != "cost") image = Image(options.width, options.height);
-    const auto accel = build_accel(scene, config);
-    if (aov == "cost") return render_cost(scene, *accel, options.width, options.height, output);
+    const auto built = build_accel(scene, config);
+    if (aov == "cost") return render_cost(scene, *built, options.width, options.height, output);
+    // --counts: the render's queries through the counting walk, summed.
+    const bool counting = p.has("--counts");
+    if (counting && scene.features.motion) throw UsageError("--counts: a moving scene's rays carry times the counting walk does not take");
+    std::optional<CountingAccel> counter;
+    if (counting) {
+        try {
+            counter.emplace(*built);
+        } catch (const std::invalid_argument& e) {
+            throw UsageError(std::string("--counts: ") + e.what());
+        }
+    }
+    const Accel* accel = counting ? static_cast<const Accel*>(&*counter) : built.get();
     options.packet = fastest ? supported_packet(*accel, fastest_config(RayWorkload::Camera).packet)
                              : packet_width_from(p, *accel);
     // Secondary rays: the widest packets (measured on balls, gears and
@@ -254,6 +272,15 @@ int run_render(const Args& args) {
                      {"refract", stats.refract_rays},
                      {"diffuse", stats.diffuse_rays}};
         j["mrays_per_s"] = mrays;
+        if (counter) {
+            const TraversalCounts c = counter->totals();
+            const double n = double(std::max<std::uint64_t>(counter->rays(), 1));
+            j["counted_rays"] = counter->rays();
+            j["n_it"] = double(c.prims) / n;
+            j["n_ts"] = double(c.nodes) / n;
+            j["n_ets"] = double(c.leaves) / n;
+            j["n_eets"] = double(c.empty_leaves) / n;
+        }
         if (options.distribution && options.adaptive_threshold == 0) j["noise_rms"] = stats.noise_rms;
         if (options.adaptive_threshold > 0) {
             j["adaptive"] = options.adaptive_threshold;
@@ -298,6 +325,13 @@ int run_render(const Args& args) {
                 (unsigned long long)stats.shadow_rays);
     if (stats.diffuse_rays) std::printf(", diffuse %llu", (unsigned long long)stats.diffuse_rays);
     std::printf("\n");
+    if (counter) {
+        const TraversalCounts c = counter->totals();
+        const double n = double(std::max<std::uint64_t>(counter->rays(), 1));
+        std::printf("  counts     per ray over %llu rays: N_IT %.2f, N_TS %.2f, N_ETS %.2f, N_EETS %.2f\n",
+                    (unsigned long long)counter->rays(), double(c.prims) / n, double(c.nodes) / n,
+                    double(c.leaves) / n, double(c.empty_leaves) / n);
+    }
     std::printf("  image      %s (written in %.1f ms)\n", std::filesystem::absolute(output).string().c_str(), write_ms);
     return 0;
 }

@@ -104,6 +104,41 @@ TEST(Cli, RenderJsonReportsTimesRaysAndThroughput) {
     EXPECT_TRUE(fs::exists(out));
 }
 
+TEST(Cli, RenderCountsHavransMeasuresOverTheWholeRenderWithTheSameImage) {
+    const fs::path plain = temp_dir() / "plain.png", counted = temp_dir() / "counted.png";
+    for (const char* accel : {"bvh4", "grid", "kdtree", "octree"}) {
+        const std::string common = std::string(" --res 64 48 --threads 2 --accel ") + accel;
+        const Result a = run("render gen:balls:2 -o " + plain.string() + common + " --json");
+        const Result b = run("render gen:balls:2 -o " + counted.string() + common + " --json --counts");
+        ASSERT_EQ(a.status, 0) << a.output;
+        ASSERT_EQ(b.status, 0) << b.output;
+        // The counting walk answers every query as the structure does.
+        EXPECT_EQ(slurp(plain), slurp(counted)) << accel;
+        const nlohmann::json ja = nlohmann::json::parse(a.output), jb = nlohmann::json::parse(b.output);
+        EXPECT_EQ(ja["rays"], jb["rays"]) << accel;
+        EXPECT_FALSE(ja.contains("n_it"));
+        const auto& r = jb["rays"];
+        EXPECT_EQ(jb["counted_rays"].get<std::uint64_t>(),
+                  r["eye"].get<std::uint64_t>() + r["shadow"].get<std::uint64_t>() +
+                      r["reflect"].get<std::uint64_t>() + r["refract"].get<std::uint64_t>())
+            << accel;
+        const double it = jb["n_it"], ts = jb["n_ts"], ets = jb["n_ets"], eets = jb["n_eets"];
+        EXPECT_GT(it, 0.0) << accel;
+        EXPECT_GT(ets, 0.0) << accel;
+        EXPECT_LE(ets, ts) << accel;
+        EXPECT_LE(eets, ets) << accel;
+    }
+#ifdef RAYPACK_HAVE_EMBREE
+    // Structures that cannot count say so.
+    const Result e = run("render gen:balls:1 -o " + counted.string() + " --res 8 8 --accel embree --counts");
+    EXPECT_EQ(e.status, 2) << e.output;
+    EXPECT_NE(e.output.find("--counts: embree cannot count"), std::string::npos) << e.output;
+#endif
+    const Result m = run("render gen:balls:1:motion -o " + counted.string() + " --res 8 8 --counts");
+    EXPECT_EQ(m.status, 2) << m.output;
+    EXPECT_NE(m.output.find("--counts: a moving scene"), std::string::npos) << m.output;
+}
+
 TEST(Cli, RenderQuietPrintsNothing) {
     const fs::path out = temp_dir() / "tetra.png";
     fs::remove(out);
