@@ -211,7 +211,8 @@ int run_render(const Args& args) {
     if (aov == "cost") return render_cost(scene, *built, options.width, options.height, output);
     // --counts: the render's queries through the counting walk, summed.
     const bool counting = p.has("--counts");
-    if (counting && scene.features.motion) throw UsageError("--counts: a moving scene's rays carry times the counting walk does not take");
+    if (counting && scene.features.motion)
+        throw UsageError("--counts: a moving scene's rays carry times the counting walk does not take");
     std::optional<CountingAccel> counter;
     if (counting) {
         try {

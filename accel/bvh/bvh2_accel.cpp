@@ -8,6 +8,7 @@
 #include "accel/bvh/bvh2_finalize.h"
 #include "accel/bvh/bvh2_packet.h"
 #include "accel/bvh/bvh2_traversal.h"
+#include "accel/packet_widths.h"
 #include "kernels/simd.h"
 
 namespace raypack {
@@ -51,25 +52,13 @@ void Bvh2Accel::occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occ
     trace<true>(rays, [&](std::size_t i, bool found, const Hitf&) { occluded[i] = found ? 1 : 0; });
 }
 
-bool Bvh2Accel::supports_packet(int width) const {
-    return width == 1 || (width == 4 && kWidthCompiled<4>) || (width == 8 && kWidthCompiled<8>) ||
-           (width == 16 && kWidthCompiled<16>);
-}
+bool Bvh2Accel::supports_packet(int width) const { return packet_width_compiled(width); }
 
 template <bool AnyHit>
 void Bvh2Accel::trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
-    switch (width) {
-#if defined(__SSE4_2__)
-        case 4: return bvh2_trace_packets<4, AnyHit>(bvh_, *scene_, kernels_, rays, hits);
-#endif
-#if defined(__AVX2__)
-        case 8: return bvh2_trace_packets<8, AnyHit>(bvh_, *scene_, kernels_, rays, hits);
-#endif
-#if defined(__AVX512BW__)
-        case 16: return bvh2_trace_packets<16, AnyHit>(bvh_, *scene_, kernels_, rays, hits);
-#endif
-        default: throw std::invalid_argument("bvh2: packet width " + std::to_string(width) + " is not compiled in");
-    }
+    with_packet_width(width, "bvh2", [&]<int K>() {
+        bvh2_trace_packets<K, AnyHit>(bvh_, *scene_, kernels_, rays, hits);
+    });
 }
 
 void Bvh2Accel::intersect_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
@@ -79,9 +68,9 @@ void Bvh2Accel::intersect_packets(int width, std::span<const Rayf> rays, std::sp
 
 void Bvh2Accel::occluded_packets(int width, std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const {
     if (width == 1) return this->occluded(rays, occluded);
-    std::vector<Hitf> hits(rays.size());
-    trace_packets<true>(width, rays, hits);
-    for (std::size_t i = 0; i < rays.size(); ++i) occluded[i] = hits[i].found() ? 1 : 0;
+    occlusion_in_slices(rays, occluded, [&](std::span<const Rayf> slice, std::span<Hitf> hits) {
+        trace_packets<true>(width, slice, hits);
+    });
 }
 
 }  // namespace raypack

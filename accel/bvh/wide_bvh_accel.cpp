@@ -8,6 +8,7 @@
 
 #include "accel/bvh/binned_sah_builder.h"
 #include "accel/bvh/build_from_scene.h"
+#include "accel/packet_widths.h"
 
 namespace raypack {
 
@@ -94,15 +95,7 @@ int packet_slot(int width) { return width == 4 ? 0 : width == 8 ? 1 : 2; }
 
 template <int N, int M, NodeTest Test>
 bool WideBvhAccel<N, M, Test>::supports_packet(int width) const {
-    if (width == 1) return true;
-    if constexpr (kPackets) {
-        switch (width) {
-            case 4: return kWidthCompiled<4>;
-            case 8: return kWidthCompiled<8>;
-            case 16: return kWidthCompiled<16>;
-        }
-    }
-    return false;
+    return width == 1 || (kPackets && packet_width_compiled(width));
 }
 
 template <int N, int M, NodeTest Test>
@@ -120,12 +113,9 @@ template <bool AnyHit>
 void WideBvhAccel<N, M, Test>::trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
     if constexpr (kPackets) {
         const WidePacketConfig& c = packet_config_[packet_slot(width)];
-        if constexpr (kWidthCompiled<4>)
-            if (width == 4) return wide_trace_packets<N, M, 4, AnyHit>(bvh_, *scene_, kernels_, c, rays, hits);
-        if constexpr (kWidthCompiled<8>)
-            if (width == 8) return wide_trace_packets<N, M, 8, AnyHit>(bvh_, *scene_, kernels_, c, rays, hits);
-        if constexpr (kWidthCompiled<16>)
-            if (width == 16) return wide_trace_packets<N, M, 16, AnyHit>(bvh_, *scene_, kernels_, c, rays, hits);
+        return with_packet_width(width, stats_.name, [&]<int K>() {
+            wide_trace_packets<N, M, K, AnyHit>(bvh_, *scene_, kernels_, c, rays, hits);
+        });
     }
     throw std::invalid_argument(stats_.name + ": packets of " + std::to_string(width) + " are not compiled in");
 }
@@ -140,15 +130,9 @@ template <int N, int M, NodeTest Test>
 void WideBvhAccel<N, M, Test>::occluded_packets(int width, std::span<const Rayf> rays,
                                                 std::span<std::uint8_t> occluded) const {
     if (width == 1 || !supports_packet(width)) return this->occluded(rays, occluded);
-    // The packet loop reports occlusion as prim 0 (accel/packet_driver.h):
-    // traced in slices through a small buffer.
-    constexpr std::size_t kSlice = 256;
-    Hitf buffer[kSlice];
-    for (std::size_t first = 0; first < rays.size(); first += kSlice) {
-        const std::size_t n = std::min(kSlice, rays.size() - first);
-        trace_packets<true>(width, rays.subspan(first, n), std::span<Hitf>(buffer, n));
-        for (std::size_t i = 0; i < n; ++i) occluded[first + i] = buffer[i].found() ? 1 : 0;
-    }
+    occlusion_in_slices(rays, occluded, [&](std::span<const Rayf> slice, std::span<Hitf> hits) {
+        trace_packets<true>(width, slice, hits);
+    });
 }
 
 #if defined(__SSE4_2__)

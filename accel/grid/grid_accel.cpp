@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "accel/cell_kernel_variants.h"
-#include "accel/count_each_ray.h"
+#include "accel/cell_accel_impl.h"
 #include "accel/grid/dda.h"
 #include "accel/grid/grid_build.h"
 #include "accel/grid/grid_packet.h"
@@ -110,77 +110,15 @@ bool GridAccel::trace(Rayf& ray, Hitf& hit, GridRayCounters* counters) const {
     return found;
 }
 
-// The slab form is chosen once per batch (with_slab_form).
-void GridAccel::intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const {
-    with_slab_form(kernels_.slabs, [&]<SlabMethod Slabs>(SlabTag<Slabs>) {
-        for (std::size_t i = 0; i < rays.size(); ++i) {
-            Rayf ray = rays[i];
-            Hitf hit;
-            trace_with<false, false, Slabs>(ray, hit, nullptr);
-            hits[i] = hit;
-        }
-    });
-}
-
-void GridAccel::occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const {
-    with_slab_form(kernels_.slabs, [&]<SlabMethod Slabs>(SlabTag<Slabs>) {
-        for (std::size_t i = 0; i < rays.size(); ++i) {
-            Rayf ray = rays[i];
-            Hitf hit;
-            occluded[i] = trace_with<true, false, Slabs>(ray, hit, nullptr) ? 1 : 0;
-        }
-    });
-}
-
-Hitf GridAccel::intersect_counting(const Rayf& ray_in, GridRayCounters& counters) const {
-    Rayf ray = ray_in;
-    Hitf hit;
-    trace<false, true>(ray, hit, &counters);
-    return hit;
-}
-
-bool GridAccel::occluded_counting(const Rayf& ray_in, GridRayCounters& counters) const {
-    Rayf ray = ray_in;
-    Hitf hit;
-    return trace<true, true>(ray, hit, &counters);
-}
-
-bool GridAccel::count_traversal(std::span<const Rayf> rays, bool any_hit, std::span<Hitf> hits,
-                                TraversalCounts& counts) const {
-    return count_each_ray<GridRayCounters>(*this, rays, any_hit, hits, counts);
-}
-
-bool GridAccel::supports_packet(int width) const {
-    return width == 1 || (width == 4 && kWidthCompiled<4>) || (width == 8 && kWidthCompiled<8>) ||
-           (width == 16 && kWidthCompiled<16>);
-}
-
 template <bool AnyHit>
 void GridAccel::trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
-    switch (width) {
-#if defined(__SSE4_2__)
-        case 4: return grid_trace_packets<4, AnyHit>(grid_, *scene_, kernels_, rays, hits);
-#endif
-#if defined(__AVX2__)
-        case 8: return grid_trace_packets<8, AnyHit>(grid_, *scene_, kernels_, rays, hits);
-#endif
-#if defined(__AVX512BW__)
-        case 16: return grid_trace_packets<16, AnyHit>(grid_, *scene_, kernels_, rays, hits);
-#endif
-        default: throw std::invalid_argument("grid: packet width " + std::to_string(width) + " is not compiled in");
-    }
+    with_packet_width(width, "grid", [&]<int K>() {
+        grid_trace_packets<K, AnyHit>(grid_, *scene_, kernels_, rays, hits);
+    });
 }
 
-void GridAccel::intersect_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
-    if (width == 1 || !grid_packets_exact(grid_)) return intersect(rays, hits);
-    trace_packets<false>(width, rays, hits);
-}
+bool GridAccel::packets_exact() const { return grid_packets_exact(grid_); }
 
-void GridAccel::occluded_packets(int width, std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const {
-    if (width == 1 || !grid_packets_exact(grid_)) return this->occluded(rays, occluded);
-    std::vector<Hitf> hits(rays.size());
-    trace_packets<true>(width, rays, hits);
-    for (std::size_t i = 0; i < rays.size(); ++i) occluded[i] = hits[i].found() ? 1 : 0;
-}
+template class CellAccel<GridAccel, GridRayCounters>;
 
 }  // namespace raypack

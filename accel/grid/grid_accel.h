@@ -4,7 +4,7 @@
 #include <array>
 #include <cstdint>
 
-#include "accel/accel.h"
+#include "accel/cell_accel.h"
 #include "accel/grid/grid.h"
 
 namespace raypack {
@@ -25,25 +25,13 @@ struct GridRayCounters {
     }
 };
 
-class GridAccel final : public Accel {
+/// Packets: K-wide traversal, each lane stepping its own DDA (grid_packet.h).
+/// It has no mailbox: its answers equal those of the single-ray walk with
+/// GridConfig::mailbox off, bit for bit.
+class GridAccel final : public CellAccel<GridAccel, GridRayCounters> {
 public:
     GridAccel(const Scene& scene, const AccelConfig& config, const GridConfig& grid_config = {});
-    void intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const override;
-    void occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override;
     const AccelStats& stats() const override { return stats_; }
-
-    /// K-wide traversal, each lane stepping its own DDA (grid_packet.h). It
-    /// has no mailbox: its answers equal those of the single-ray walk with
-    /// GridConfig::mailbox off, bit for bit.
-    bool supports_packet(int width) const override;
-    void intersect_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const override;
-    void occluded_packets(int width, std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override;
-
-    /// The same queries, adding each ray's work to `counters` (slower; tests and analysis).
-    Hitf intersect_counting(const Rayf& ray, GridRayCounters& counters) const;
-    bool occluded_counting(const Rayf& ray, GridRayCounters& counters) const;
-    bool count_traversal(std::span<const Rayf> rays, bool any_hit, std::span<Hitf> hits,
-                         TraversalCounts& counts) const override;
 
     const Grid& grid() const { return grid_; }
     std::array<int, 3> resolution() const { return grid_.geometry.res; }
@@ -58,22 +46,19 @@ public:
     std::size_t empty_cells() const { return empty_cells_; }
 
 private:
+    friend class CellAccel<GridAccel, GridRayCounters>;
     template <bool AnyHit>
     void trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const;
     template <bool AnyHit, bool Counting, bool Mailbox, SlabMethod Slabs>
     bool trace(Rayf& ray, Hitf& hit, GridRayCounters* counters) const;
-    /// trace() with or without the mailbox, chosen per ray as before the variants.
+    /// One ray: trace() with or without the mailbox, chosen per ray as before the variants.
     template <bool AnyHit, bool Counting, SlabMethod Slabs>
-    bool trace_with(Rayf& ray, Hitf& hit, GridRayCounters* counters) const {
+    bool walk(Rayf& ray, Hitf& hit, GridRayCounters* counters) const {
         return mailbox_ ? trace<AnyHit, Counting, true, Slabs>(ray, hit, counters)
                         : trace<AnyHit, Counting, false, Slabs>(ray, hit, counters);
     }
-    /// The counting walk picks the slab form per ray (it is never timed).
-    template <bool AnyHit, bool Counting>
-    bool trace(Rayf& ray, Hitf& hit, GridRayCounters* counters) const {
-        return kernels_.slabs == SlabMethod::Plain ? trace_with<AnyHit, Counting, SlabMethod::Plain>(ray, hit, counters)
-                                                   : trace_with<AnyHit, Counting, SlabMethod::Robust>(ray, hit, counters);
-    }
+    bool packets_exact() const;
+    SlabMethod slab_method() const { return kernels_.slabs; }
 
     const Scene* scene_;
     KernelChoice kernels_;
@@ -82,5 +67,7 @@ private:
     bool mailbox_ = true;
     AccelStats stats_;
 };
+
+extern template class CellAccel<GridAccel, GridRayCounters>;  // grid_accel.cpp
 
 }  // namespace raypack

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "accel/cell_kernel_variants.h"
-#include "accel/count_each_ray.h"
+#include "accel/cell_accel_impl.h"
 #include "accel/kdtree/kdtree_build.h"
 #include "accel/kdtree/kdtree_packet.h"
 #include "accel/kdtree/kdtree_ray_interval.h"
@@ -76,7 +76,7 @@ namespace {
 // the margin: pbrt's traversal, whose misses near planes the robust form's
 // margin exists to avoid.
 template <bool AnyHit, bool Counting, SlabMethod Slabs>
-bool KdTreeAccel::trace(Rayf& ray, Hitf& hit, KdRayCounters* counters) const {
+bool KdTreeAccel::walk(Rayf& ray, Hitf& hit, KdRayCounters* counters) const {
     if constexpr (Counting) ++counters->rays;
     if (tree_.empty()) return false;
     const Vec3f rdir = ray_reciprocal(ray.dir, kernels_.rcp);
@@ -163,77 +163,13 @@ bool KdTreeAccel::trace(Rayf& ray, Hitf& hit, KdRayCounters* counters) const {
     }
 }
 
-// The slab form is chosen once per batch (with_slab_form).
-void KdTreeAccel::intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const {
-    with_slab_form(kernels_.slabs, [&]<SlabMethod Slabs>(SlabTag<Slabs>) {
-        for (std::size_t i = 0; i < rays.size(); ++i) {
-            Rayf ray = rays[i];
-            Hitf hit;
-            trace<false, false, Slabs>(ray, hit, nullptr);
-            hits[i] = hit;
-        }
-    });
-}
-
-void KdTreeAccel::occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const {
-    with_slab_form(kernels_.slabs, [&]<SlabMethod Slabs>(SlabTag<Slabs>) {
-        for (std::size_t i = 0; i < rays.size(); ++i) {
-            Rayf ray = rays[i];
-            Hitf hit;
-            occluded[i] = trace<true, false, Slabs>(ray, hit, nullptr) ? 1 : 0;
-        }
-    });
-}
-
-Hitf KdTreeAccel::intersect_counting(const Rayf& ray_in, KdRayCounters& counters) const {
-    Rayf ray = ray_in;
-    Hitf hit;
-    trace<false, true>(ray, hit, &counters);
-    return hit;
-}
-
-bool KdTreeAccel::occluded_counting(const Rayf& ray_in, KdRayCounters& counters) const {
-    Rayf ray = ray_in;
-    Hitf hit;
-    return trace<true, true>(ray, hit, &counters);
-}
-
-bool KdTreeAccel::count_traversal(std::span<const Rayf> rays, bool any_hit, std::span<Hitf> hits,
-                                  TraversalCounts& counts) const {
-    return count_each_ray<KdRayCounters>(*this, rays, any_hit, hits, counts);
-}
-
-bool KdTreeAccel::supports_packet(int width) const {
-    return width == 1 || (width == 4 && kWidthCompiled<4>) || (width == 8 && kWidthCompiled<8>) ||
-           (width == 16 && kWidthCompiled<16>);
-}
-
 template <bool AnyHit>
 void KdTreeAccel::trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
-    switch (width) {
-#if defined(__SSE4_2__)
-        case 4: return kdtree_trace_packets<4, AnyHit>(tree_, *scene_, kernels_, rays, hits);
-#endif
-#if defined(__AVX2__)
-        case 8: return kdtree_trace_packets<8, AnyHit>(tree_, *scene_, kernels_, rays, hits);
-#endif
-#if defined(__AVX512BW__)
-        case 16: return kdtree_trace_packets<16, AnyHit>(tree_, *scene_, kernels_, rays, hits);
-#endif
-        default: throw std::invalid_argument("kdtree: packet width " + std::to_string(width) + " is not compiled in");
-    }
+    with_packet_width(width, "kdtree", [&]<int K>() {
+        kdtree_trace_packets<K, AnyHit>(tree_, *scene_, kernels_, rays, hits);
+    });
 }
 
-void KdTreeAccel::intersect_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
-    if (width == 1) return intersect(rays, hits);
-    trace_packets<false>(width, rays, hits);
-}
-
-void KdTreeAccel::occluded_packets(int width, std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const {
-    if (width == 1) return this->occluded(rays, occluded);
-    std::vector<Hitf> hits(rays.size());
-    trace_packets<true>(width, rays, hits);
-    for (std::size_t i = 0; i < rays.size(); ++i) occluded[i] = hits[i].found() ? 1 : 0;
-}
+template class CellAccel<KdTreeAccel, KdRayCounters>;
 
 }  // namespace raypack

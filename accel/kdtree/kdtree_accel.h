@@ -4,7 +4,7 @@
 // ray at a time or in packets of K.
 #include <cstdint>
 
-#include "accel/accel.h"
+#include "accel/cell_accel.h"
 #include "accel/kdtree/kdtree.h"
 
 namespace raypack {
@@ -24,21 +24,10 @@ struct KdRayCounters {
     }
 };
 
-class KdTreeAccel final : public Accel {
+class KdTreeAccel final : public CellAccel<KdTreeAccel, KdRayCounters> {
 public:
     KdTreeAccel(const Scene& scene, const AccelConfig& config, const KdTreeConfig& kd_config = {});
-    void intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const override;
-    void occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override;
     const AccelStats& stats() const override { return stats_; }
-    bool supports_packet(int width) const override;
-    void intersect_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const override;
-    void occluded_packets(int width, std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override;
-
-    /// The same queries, adding each ray's work to `counters` (slower; tests and analysis).
-    Hitf intersect_counting(const Rayf& ray, KdRayCounters& counters) const;
-    bool occluded_counting(const Rayf& ray, KdRayCounters& counters) const;
-    bool count_traversal(std::span<const Rayf> rays, bool any_hit, std::span<Hitf> hits,
-                         TraversalCounts& counts) const override;
 
     const KdTree& tree() const { return tree_; }
     /// References per primitive: how often the average primitive is stored.
@@ -46,21 +35,20 @@ public:
     std::size_t empty_leaves() const { return tree_.empty_leaves; }
 
 private:
+    friend class CellAccel<KdTreeAccel, KdRayCounters>;
     template <bool AnyHit, bool Counting, SlabMethod Slabs>
-    bool trace(Rayf& ray, Hitf& hit, KdRayCounters* counters) const;
-    /// The counting walk picks the slab form per ray (it is never timed).
-    template <bool AnyHit, bool Counting>
-    bool trace(Rayf& ray, Hitf& hit, KdRayCounters* counters) const {
-        return kernels_.slabs == SlabMethod::Plain ? trace<AnyHit, Counting, SlabMethod::Plain>(ray, hit, counters)
-                                                   : trace<AnyHit, Counting, SlabMethod::Robust>(ray, hit, counters);
-    }
+    bool walk(Rayf& ray, Hitf& hit, KdRayCounters* counters) const;
     template <bool AnyHit>
     void trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const;
+    bool packets_exact() const { return true; }
+    SlabMethod slab_method() const { return kernels_.slabs; }
 
     const Scene* scene_;
     KernelChoice kernels_;
     KdTree tree_;
     AccelStats stats_;
 };
+
+extern template class CellAccel<KdTreeAccel, KdRayCounters>;  // kdtree_accel.cpp
 
 }  // namespace raypack

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "accel/cell_kernel_variants.h"
-#include "accel/count_each_ray.h"
+#include "accel/cell_accel_impl.h"
 #include "accel/octree/octree_build.h"
 #include "accel/octree/octree_packet.h"
 #include "accel/octree/revelles.h"
@@ -64,7 +64,7 @@ struct Frame {
 // Slabs: the form of the root cube's plane distances, the only ones the walk
 // computes from coordinates (every child's come from them as midpoints).
 template <bool AnyHit, bool Counting, SlabMethod Slabs>
-bool OctreeAccel::trace(Rayf& ray, Hitf& hit, OctreeRayCounters* counters) const {
+bool OctreeAccel::walk(Rayf& ray, Hitf& hit, OctreeRayCounters* counters) const {
     if constexpr (Counting) ++counters->rays;
     if (tree_.empty()) return false;
     const Vec3f rdir = ray_reciprocal(ray.dir, kernels_.rcp);
@@ -151,77 +151,13 @@ bool OctreeAccel::trace(Rayf& ray, Hitf& hit, OctreeRayCounters* counters) const
     return found;
 }
 
-// The slab form is chosen once per batch (with_slab_form).
-void OctreeAccel::intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const {
-    with_slab_form(kernels_.slabs, [&]<SlabMethod Slabs>(SlabTag<Slabs>) {
-        for (std::size_t i = 0; i < rays.size(); ++i) {
-            Rayf ray = rays[i];
-            Hitf hit;
-            trace<false, false, Slabs>(ray, hit, nullptr);
-            hits[i] = hit;
-        }
-    });
-}
-
-void OctreeAccel::occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const {
-    with_slab_form(kernels_.slabs, [&]<SlabMethod Slabs>(SlabTag<Slabs>) {
-        for (std::size_t i = 0; i < rays.size(); ++i) {
-            Rayf ray = rays[i];
-            Hitf hit;
-            occluded[i] = trace<true, false, Slabs>(ray, hit, nullptr) ? 1 : 0;
-        }
-    });
-}
-
-Hitf OctreeAccel::intersect_counting(const Rayf& ray_in, OctreeRayCounters& counters) const {
-    Rayf ray = ray_in;
-    Hitf hit;
-    trace<false, true>(ray, hit, &counters);
-    return hit;
-}
-
-bool OctreeAccel::occluded_counting(const Rayf& ray_in, OctreeRayCounters& counters) const {
-    Rayf ray = ray_in;
-    Hitf hit;
-    return trace<true, true>(ray, hit, &counters);
-}
-
-bool OctreeAccel::count_traversal(std::span<const Rayf> rays, bool any_hit, std::span<Hitf> hits,
-                                  TraversalCounts& counts) const {
-    return count_each_ray<OctreeRayCounters>(*this, rays, any_hit, hits, counts);
-}
-
-bool OctreeAccel::supports_packet(int width) const {
-    return width == 1 || (width == 4 && kWidthCompiled<4>) || (width == 8 && kWidthCompiled<8>) ||
-           (width == 16 && kWidthCompiled<16>);
-}
-
 template <bool AnyHit>
 void OctreeAccel::trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
-    switch (width) {
-#if defined(__SSE4_2__)
-        case 4: return octree_trace_packets<4, AnyHit>(tree_, *scene_, kernels_, rays, hits);
-#endif
-#if defined(__AVX2__)
-        case 8: return octree_trace_packets<8, AnyHit>(tree_, *scene_, kernels_, rays, hits);
-#endif
-#if defined(__AVX512BW__)
-        case 16: return octree_trace_packets<16, AnyHit>(tree_, *scene_, kernels_, rays, hits);
-#endif
-        default: throw std::invalid_argument("octree: packet width " + std::to_string(width) + " is not compiled in");
-    }
+    with_packet_width(width, "octree", [&]<int K>() {
+        octree_trace_packets<K, AnyHit>(tree_, *scene_, kernels_, rays, hits);
+    });
 }
 
-void OctreeAccel::intersect_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
-    if (width == 1) return intersect(rays, hits);
-    trace_packets<false>(width, rays, hits);
-}
-
-void OctreeAccel::occluded_packets(int width, std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const {
-    if (width == 1) return this->occluded(rays, occluded);
-    std::vector<Hitf> hits(rays.size());
-    trace_packets<true>(width, rays, hits);
-    for (std::size_t i = 0; i < rays.size(); ++i) occluded[i] = hits[i].found() ? 1 : 0;
-}
+template class CellAccel<OctreeAccel, OctreeRayCounters>;
 
 }  // namespace raypack

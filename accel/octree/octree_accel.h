@@ -3,7 +3,7 @@
 // Lastra (WSCG 2000); single ray and K-wide packets.
 #include <cstdint>
 
-#include "accel/accel.h"
+#include "accel/cell_accel.h"
 #include "accel/octree/octree.h"
 
 namespace raypack {
@@ -23,22 +23,10 @@ struct OctreeRayCounters {
     }
 };
 
-class OctreeAccel final : public Accel {
+class OctreeAccel final : public CellAccel<OctreeAccel, OctreeRayCounters> {
 public:
     OctreeAccel(const Scene& scene, const AccelConfig& config, const OctreeConfig& octree_config = {});
-    void intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const override;
-    void occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override;
     const AccelStats& stats() const override { return stats_; }
-
-    bool supports_packet(int width) const override;
-    void intersect_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const override;
-    void occluded_packets(int width, std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override;
-
-    /// The same queries, adding each ray's work to `counters` (slower; tests and analysis).
-    Hitf intersect_counting(const Rayf& ray, OctreeRayCounters& counters) const;
-    bool occluded_counting(const Rayf& ray, OctreeRayCounters& counters) const;
-    bool count_traversal(std::span<const Rayf> rays, bool any_hit, std::span<Hitf> hits,
-                         TraversalCounts& counts) const override;
 
     const Octree& octree() const { return tree_; }
     std::size_t reference_count() const { return tree_.refs.size(); }
@@ -47,16 +35,13 @@ public:
     std::size_t empty_leaves() const { return empty_leaves_; }
 
 private:
+    friend class CellAccel<OctreeAccel, OctreeRayCounters>;
     template <bool AnyHit, bool Counting, SlabMethod Slabs>
-    bool trace(Rayf& ray, Hitf& hit, OctreeRayCounters* counters) const;
-    /// The counting walk picks the slab form per ray (it is never timed).
-    template <bool AnyHit, bool Counting>
-    bool trace(Rayf& ray, Hitf& hit, OctreeRayCounters* counters) const {
-        return kernels_.slabs == SlabMethod::Plain ? trace<AnyHit, Counting, SlabMethod::Plain>(ray, hit, counters)
-                                                   : trace<AnyHit, Counting, SlabMethod::Robust>(ray, hit, counters);
-    }
+    bool walk(Rayf& ray, Hitf& hit, OctreeRayCounters* counters) const;
     template <bool AnyHit>
     void trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const;
+    bool packets_exact() const { return true; }
+    SlabMethod slab_method() const { return kernels_.slabs; }
 
     const Scene* scene_;
     KernelChoice kernels_;
@@ -64,5 +49,7 @@ private:
     std::size_t empty_leaves_ = 0;
     AccelStats stats_;
 };
+
+extern template class CellAccel<OctreeAccel, OctreeRayCounters>;  // octree_accel.cpp
 
 }  // namespace raypack
