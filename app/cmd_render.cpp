@@ -241,6 +241,17 @@ int run_render(const Args& args) {
     const double write_ms = ms_since(t0);
     const double mrays = stats.render_ms > 0 ? double(stats.total_rays()) / (stats.render_ms * 1e3) : 0.0;
 
+    // --counts: Havran's measures per ray over every ray of the render.
+    struct PerRay {
+        double it, ts, ets, eets;
+    };
+    std::optional<PerRay> per_ray;
+    if (counter) {
+        const TraversalCounts c = counter->totals();
+        const double n = double(std::max<std::uint64_t>(counter->rays(), 1));
+        per_ray = PerRay{double(c.prims) / n, double(c.nodes) / n, double(c.leaves) / n, double(c.empty_leaves) / n};
+    }
+
     const AccelStats& as = accel->stats();
     if (json) {
         nlohmann::json j;
@@ -273,14 +284,12 @@ int run_render(const Args& args) {
                      {"refract", stats.refract_rays},
                      {"diffuse", stats.diffuse_rays}};
         j["mrays_per_s"] = mrays;
-        if (counter) {
-            const TraversalCounts c = counter->totals();
-            const double n = double(std::max<std::uint64_t>(counter->rays(), 1));
+        if (per_ray) {
             j["counted_rays"] = counter->rays();
-            j["n_it"] = double(c.prims) / n;
-            j["n_ts"] = double(c.nodes) / n;
-            j["n_ets"] = double(c.leaves) / n;
-            j["n_eets"] = double(c.empty_leaves) / n;
+            j["n_it"] = per_ray->it;
+            j["n_ts"] = per_ray->ts;
+            j["n_ets"] = per_ray->ets;
+            j["n_eets"] = per_ray->eets;
         }
         if (options.distribution && options.adaptive_threshold == 0) j["noise_rms"] = stats.noise_rms;
         if (options.adaptive_threshold > 0) {
@@ -326,13 +335,9 @@ int run_render(const Args& args) {
                 (unsigned long long)stats.shadow_rays);
     if (stats.diffuse_rays) std::printf(", diffuse %llu", (unsigned long long)stats.diffuse_rays);
     std::printf("\n");
-    if (counter) {
-        const TraversalCounts c = counter->totals();
-        const double n = double(std::max<std::uint64_t>(counter->rays(), 1));
+    if (per_ray)
         std::printf("  counts     per ray over %llu rays: N_IT %.2f, N_TS %.2f, N_ETS %.2f, N_EETS %.2f\n",
-                    (unsigned long long)counter->rays(), double(c.prims) / n, double(c.nodes) / n,
-                    double(c.leaves) / n, double(c.empty_leaves) / n);
-    }
+                    (unsigned long long)counter->rays(), per_ray->it, per_ray->ts, per_ray->ets, per_ray->eets);
     std::printf("  image      %s (written in %.1f ms)\n", std::filesystem::absolute(output).string().c_str(), write_ms);
     return 0;
 }
