@@ -2,6 +2,8 @@
 // shared scene x structure x native packet width x ray kind, named
 // scene/SCENE/ACCEL/RAYS/K (e.g. scene/balls/bvh8/camera/8), one thread,
 // each checked against the brute-force oracle on a sample before timing.
+// ACCEL grid-lanes is the grid with every packet stepping its lanes' own
+// DDAs (GridConfig::coherent_packets off), to compare with the coherent walk.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -12,6 +14,7 @@
 #include <vector>
 
 #include "accel/accel.h"
+#include "accel/grid/grid_accel.h"
 #include "measure/ray_sets.h"
 #include "scene/load.h"
 
@@ -74,13 +77,21 @@ std::string disagreement(const Scene& scene, bool any_hit, const std::vector<Ray
     return {};
 }
 
+/// The structure `kind` names, or the grid without coherent packets for "grid-lanes".
+std::unique_ptr<Accel> build_structure(const Scene& scene, const std::string& kind) {
+    if (kind != "grid-lanes") return build_accel(scene, accel_config(kind));
+    GridConfig lanes;
+    lanes.coherent_packets = false;
+    return std::make_unique<GridAccel>(scene, accel_config("grid"), lanes);
+}
+
 void scene_case(benchmark::State& state, const std::string& file, const std::string& kind, const std::string& rays_kind,
                 int packet) {
     SceneData& data = scene_data(file);
     const std::vector<Rayf>& rays = data.rays.at(rays_kind);
     if (rays.empty()) return state.SkipWithError("no rays of this kind in this scene");
     const bool any_hit = rays_kind == "shadow";
-    const auto accel = build_accel(data.scene, accel_config(kind));
+    const auto accel = build_structure(data.scene, kind);
     std::vector<Hitf> hits(rays.size());
     trace(*accel, packet, any_hit, rays, hits);
     if (const std::string why = disagreement(data.scene, any_hit, rays, hits); !why.empty())
@@ -100,9 +111,11 @@ bool registered_in_bench_wide_bvh(const std::string& kind, const std::string& ra
 /// One case per native width of each structure (asked of a one-sphere scene).
 void register_scene_cases() {
     const Scene probe = load_scene("gen:balls:1");
-    for (const char* kind : accel_kinds()) {
-        if (std::string(kind) == "brute") continue;  // the oracle: minutes per case on the large scenes
-        const auto accel = build_accel(probe, accel_config(kind));
+    std::vector<std::string> kinds(accel_kinds().begin(), accel_kinds().end());
+    kinds.insert(std::find(kinds.begin(), kinds.end(), "grid") + 1, "grid-lanes");
+    for (const std::string& kind : kinds) {
+        if (kind == "brute") continue;  // the oracle: minutes per case on the large scenes
+        const auto accel = build_structure(probe, kind);
         for (int packet : {1, 4, 8, 16}) {
             if (!accel->supports_packet(packet)) continue;
             for (const char* file : kScenes)
@@ -110,7 +123,7 @@ void register_scene_cases() {
                     if (registered_in_bench_wide_bvh(kind, rays_kind, packet)) continue;
                     const std::string scene = std::string(file).substr(0, std::string(file).find('.'));
                     const std::string name = "scene/" + scene + "/" + kind + "/" + rays_kind + "/" + std::to_string(packet);
-                    benchmark::RegisterBenchmark(name.c_str(), scene_case, std::string(file), std::string(kind),
+                    benchmark::RegisterBenchmark(name.c_str(), scene_case, std::string(file), kind,
                                                  std::string(rays_kind), packet)
                         ->Unit(benchmark::kMillisecond);
                 }

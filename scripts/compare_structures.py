@@ -9,6 +9,11 @@ width; "-" where a structure has no packets of that width. This is how the
 structure table of docs/structures.md is made.
 
 usage: scripts/compare_structures.py [--res 1024] [--repeat 5] [SCENE ...]
+       scripts/compare_structures.py --best --accels bvh4,grid,octree,kdtree --packets 1,4,8,16 [SCENE ...]
+
+--best: one row per scene, every structure at its fastest width against the
+first structure at its fastest (bvh4 at 16 is the default configuration
+for camera rays): the measure of issue 21.
 """
 import argparse
 import json
@@ -41,14 +46,13 @@ def main():
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--accels", default="bvh2,grid,octree,kdtree")
     ap.add_argument("--packets", default="1,8,16")
+    ap.add_argument("--best", action="store_true", help="each structure at its fastest width")
     args = ap.parse_args()
     accels = args.accels.split(",")
     packets = [int(p) for p in args.packets.split(",")]
-    print("| scene | K | " + " | ".join(f"{a} Mrays/s" for a in accels) + " | " +
-          " | ".join(f"{a}/{accels[0]}" for a in accels[1:]) + " |")
-    print("|---" * (2 + 2 * len(accels) - 1) + "|")
-    paths = [scene if scene.startswith("gen:") else os.path.join(ROOT, scene) for scene in args.scenes]
-    rows = bench(paths, accels, packets, args.res, args.repeat)
+    if args.best:
+        return print_best(args, accels, packets)
+    paths, rows = table_head(args, accels, packets, ["scene", "K"], " Mrays/s")
     for scene, path in zip(args.scenes, paths):
         for k in packets:
             rate = {a: rows[(path, a, k)]["mrays_per_s_median"] if (path, a, k) in rows else None for a in accels}
@@ -56,6 +60,29 @@ def main():
             cells = [f"{rate[a]:.2f}" if rate[a] else "-" for a in accels]
             ratios = [f"{rate[a] / base:.2f}" if rate[a] and base else "-" for a in accels[1:]]
             print(f"| {scene} | {k} | " + " | ".join(cells) + " | " + " | ".join(ratios) + " |", flush=True)
+    return 0
+
+
+def table_head(args, accels, packets, first_columns, rate_suffix):
+    """Prints the table's head, runs the bench: (scene paths, rows)."""
+    print("| " + " | ".join(first_columns) + " | " + " | ".join(f"{a}{rate_suffix}" for a in accels) + " | " +
+          " | ".join(f"{a}/{accels[0]}" for a in accels[1:]) + " |")
+    print("|---" * (len(first_columns) + 2 * len(accels) - 1) + "|")
+    paths = [scene if scene.startswith("gen:") else os.path.join(ROOT, scene) for scene in args.scenes]
+    return paths, bench(paths, accels, packets, args.res, args.repeat)
+
+
+def print_best(args, accels, packets):
+    paths, rows = table_head(args, accels, packets, ["scene"], " Mrays/s (K)")
+    for scene, path in zip(args.scenes, paths):
+        best = {}
+        for a in accels:
+            rates = [(rows[(path, a, k)]["mrays_per_s_median"], k) for k in packets if (path, a, k) in rows]
+            best[a] = max(rates) if rates else None
+        base = best[accels[0]]
+        cells = [f"{best[a][0]:.2f} ({best[a][1]})" if best[a] else "-" for a in accels]
+        ratios = [f"{best[a][0] / base[0]:.2f}" if best[a] and base else "-" for a in accels[1:]]
+        print(f"| {scene} | " + " | ".join(cells) + " | " + " | ".join(ratios) + " |", flush=True)
     return 0
 
 

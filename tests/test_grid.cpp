@@ -26,6 +26,7 @@
 #include "tests/oracle_harness.h"
 #include "accel/accel.h"
 #include "accel/brute/brute_force.h"
+#include "accel/grid/coherent_grid.h"
 #include "accel/grid/dda.h"
 #include "accel/grid/dda_packet.h"
 #include "accel/grid/grid_accel.h"
@@ -219,7 +220,8 @@ TEST_P(Grid, MatchesBruteForce) {
         nonempty += grid.grid().cell_begin[c + 1] > grid.grid().cell_begin[c];
     EXPECT_EQ(s.leaves, nonempty);
     EXPECT_DOUBLE_EQ(grid.empty_cell_fraction(), 1.0 - double(nonempty) / double(grid.cell_count()));
-    EXPECT_EQ(s.bytes, (grid.cell_count() + 1 + grid.reference_count()) * sizeof(std::uint32_t));
+    EXPECT_EQ(s.bytes, (grid.cell_count() + 1 + grid.reference_count()) * sizeof(std::uint32_t) +
+                           grid.grid().macro.full.size());
     EXPECT_GE(grid.references_per_primitive(), 1.0);
     const double cells_per_prim = double(grid.cell_count()) / double(scene.primitive_count());
     const double lambda = GridConfig{}.lambda;
@@ -791,9 +793,10 @@ TEST_F(Grid, PacketDdaWalksLikeSingleRays) {
 }
 
 TEST_F(Grid, PacketsEqualSingleRays) {
-    // Packets have no mailbox, so they must equal the single-ray walk without
-    // one bit for bit: the same cells in the same order per lane, the same
-    // kernels. Against the default walk (with mailbox) only ties may differ.
+    // Packets stepping their lanes' own DDAs have no mailbox, so they must
+    // equal the single-ray walk without one bit for bit: the same cells in
+    // the same order per lane, the same kernels. Against the default walk
+    // (with mailbox), and for the coherent walk, only ties may differ.
     const KernelChoice variants[] = {
         {SphereMethod::Geometric, TriangleMethod::Moeller},
         {SphereMethod::Algebraic, TriangleMethod::Watertight},
@@ -807,6 +810,7 @@ TEST_F(Grid, PacketsEqualSingleRays) {
             config.kernels = kc;
             GridConfig no_mailbox;
             no_mailbox.mailbox = false;
+            no_mailbox.coherent_packets = false;
             const GridAccel grid(scene, config, no_mailbox);
             std::vector<Rayf> rays = camera_rays(scene, 40);
             const std::vector<Rayf> random = random_rays(scene, rng, 800, kOriginGrowth);
@@ -845,9 +849,202 @@ TEST_F(Grid, PacketsEqualSingleRays) {
                 std::size_t n = 0;
                 const std::string first = hit_mismatches(rays, mailboxed, got, n);
                 EXPECT_EQ(n, 0u) << first;
+                // The default grid: coherent packets walk slice by slice.
+                std::vector<Hitf> coherent(rays.size());
+                with_mailbox.intersect_packets(width, rays, coherent);
+                const std::string differ_coherent = hit_mismatches(rays, want, coherent, n);
+                EXPECT_EQ(n, 0u) << differ_coherent;
+                with_mailbox.occluded_packets(width, shadows, occ);
+                EXPECT_EQ(occ, want_occ);
             }
         }
     }
+}
+
+// ---- Packets: the coherent walk (coherent_grid.h) ----------------------------------------
+
+TEST_F(Grid, MacrocellsMarkExactlyTheOccupiedBlocks) {
+    for (const char* file : {"tetra.nff", "tree.nff"}) {
+        const Scene scene = load_scene(std::string(RAYPACK_SOURCE_DIR) + "/scenes/" + file);
+        const auto grid = make_grid(scene);
+        const raypack::Grid& g = grid->grid();
+        const MacroCells& m = g.macro;
+        std::size_t blocks_full = 0;
+        for (int z = 0; z < m.res[2]; ++z)
+            for (int y = 0; y < m.res[1]; ++y)
+                for (int x = 0; x < m.res[0]; ++x) {
+                    bool any_refs = false;
+                    for (int cz = z << m.shift; cz < std::min(g.geometry.res[2], (z + 1) << m.shift); ++cz)
+                        for (int cy = y << m.shift; cy < std::min(g.geometry.res[1], (y + 1) << m.shift); ++cy)
+                            for (int cx = x << m.shift; cx < std::min(g.geometry.res[0], (x + 1) << m.shift); ++cx) {
+                                const std::uint32_t c = g.geometry.cell_index(cx, cy, cz);
+                                any_refs = any_refs || g.cell_begin[c + 1] > g.cell_begin[c];
+                            }
+                    ASSERT_EQ(m.any(x, y, z), any_refs) << file << " block " << x << " " << y << " " << z;
+                    blocks_full += any_refs;
+                }
+        for (int a = 0; a < 3; ++a) EXPECT_EQ(m.res[a], (g.geometry.res[a] + (1 << m.shift) - 1) >> m.shift);
+        // Both scenes leave blocks empty: the walk has something to skip.
+        EXPECT_LT(blocks_full, m.full.size()) << file;
+    }
+}
+
+/// Bundles of 16 rays around each base ray that share its major direction:
+/// the base ray itself (unchanged, so the bundle keeps its edge case) and
+/// copies with origins moved by up to `spread_origin` and directions tilted
+/// by up to `spread_dir` radians.
+std::vector<Rayf> bundles(const std::vector<Rayf>& base, std::mt19937& rng, float spread_origin, float spread_dir) {
+    std::uniform_real_distribution<float> u(-1, 1);
+    std::vector<Rayf> rays;
+    for (const Rayf& b : base) {
+        const float len = length(b.dir);
+        for (int l = 0; l < 16; ++l) {
+            Rayf r = b;
+            if (l > 0) {
+                r.org = b.org + Vec3f{u(rng), u(rng), u(rng)} * spread_origin;
+                r.dir = b.dir + Vec3f{u(rng), u(rng), u(rng)} * (spread_dir * len);
+            }
+            rays.push_back(r);
+        }
+    }
+    return rays;
+}
+
+/// Packets of width K through the coherent walk directly, against brute
+/// force. Where the walk leaves off (its rays diverged), brute force over
+/// what is left of each remaining lane (up to its closest hit so far)
+/// finishes it. Returns how many closest-hit packets the walk finished.
+template <int K>
+int expect_coherent_walk_matches(const GridAccel& grid, const Scene& scene, const std::vector<Rayf>& rays,
+                                 const std::string& what) {
+    using F = vfloat<K>;
+    const BruteForce brute(scene, KernelChoice{});
+    const std::vector<Hitf> truth = trace(brute, rays);
+    const PacketPrimitiveIntersector<F> isect{&scene, KernelChoice{}};
+    const GridGeometry& g = grid.grid().geometry;
+    std::vector<Hitf> got(rays.size());
+    std::vector<std::uint8_t> occluded(rays.size()), want_occluded(rays.size());
+    for (std::size_t i = 0; i < rays.size(); ++i) want_occluded[i] = truth[i].found();
+    int finished = 0;
+    for (std::size_t first = 0; first + K <= rays.size(); first += K) {
+        for (const bool any_hit : {false, true}) {
+            vmask<K> valid;
+            RayPacket<K> ray = load_packet<K>(std::span<const Rayf>(rays).subspan(first, K), valid);
+            HitPacket<K> hit;
+            hit.t = F(std::numeric_limits<float>::infinity());
+            hit.u = hit.v = F(0.0f);
+            for (auto& p : hit.prim) p = kNoPrim;
+            vmask<K> occ = valid & !valid;
+            const SlabRay<F> slab = make_slab_ray(ray.org, ray.rdir, ray.tnear, ray.tfar);
+            F entry;
+            vmask<K> active =
+                intersect_box<SlabMethod::Robust, F>(valid, slab, splat<F>(g.bounds.lo), splat<F>(g.bounds.hi), entry);
+            const int k = any(active) ? coherent_grid::major_axis<K>(ray, active) : -1;
+            std::uint32_t left = 0;
+            if (k >= 0) {
+                const bool done =
+                    any_hit ? coherent_grid::trace<K, true>(grid.grid(), isect, k, ray, hit, active, entry, occ)
+                            : coherent_grid::trace<K, false>(grid.grid(), isect, k, ray, hit, active, entry, occ);
+                if (!done) left = mask_bits(active);
+                finished += done && !any_hit;
+            } else {
+                left = mask_bits(active);  // not coherent: all of it by brute force
+            }
+            alignas(64) float t[K], u[K], v[K], tfar[K];
+            store_lanes(t, hit.t), store_lanes(u, hit.u), store_lanes(v, hit.v), store_lanes(tfar, ray.tfar);
+            const std::uint32_t o = mask_bits(occ);
+            for (int l = 0; l < K; ++l) {
+                const std::size_t i = first + std::size_t(l);
+                Hitf h{t[l], hit.prim[l], u[l], v[l]};
+                if ((left >> l) & 1u) {
+                    Rayf rest = rays[i];
+                    rest.tfar = any_hit ? rest.tfar : tfar[l];
+                    const Hitf b = brute.intersect1(rest);
+                    if (b.found()) h = b;
+                    if (any_hit) occluded[i] = b.found();
+                }
+                if (any_hit) occluded[i] |= (o >> l) & 1u;
+                else got[i] = h;
+            }
+        }
+    }
+    std::size_t n = 0;
+    const std::string hits = hit_mismatches(rays, truth, got, n);
+    EXPECT_EQ(n, 0u) << what << " K=" << K << ": " << n << " of " << rays.size() << " closest hits differ" << hits;
+    const std::string occ = occlusion_mismatches(rays, want_occluded, occluded, n);
+    EXPECT_EQ(n, 0u) << what << " K=" << K << ": " << n << " of " << rays.size() << " occlusion answers differ" << occ;
+    return finished;
+}
+
+template <int K>
+void expect_coherent_walks(const std::string& file, std::mt19937& rng, int bundle_count = 200) {
+    const Scene scene = load_scene(std::string(RAYPACK_SOURCE_DIR) + "/scenes/" + file);
+    const auto grid = make_grid(scene);
+    const GridGeometry& g = grid->grid().geometry;
+    const float cell = std::min({g.cell_size.x, g.cell_size.y, g.cell_size.z});
+    // Camera rays of the middle 64 x 64 pixels of a 512 x 512 image: the
+    // walk finishes most packets.
+    const std::vector<Rayf> full = camera_rays(scene, 512);
+    std::vector<Rayf> camera;
+    for (int y = 224; y < 288; ++y)
+        camera.insert(camera.end(), full.begin() + y * 512 + 224, full.begin() + y * 512 + 288);
+    const int finished = expect_coherent_walk_matches<K>(*grid, scene, camera, file + " camera");
+    EXPECT_GE(finished, int(camera.size() / K) * 3 / 4) << file << " K=" << K;
+    // Tight bundles around rays that make a DDA stumble (cell edges, planes,
+    // corners, axis-parallel, far origins, tnear and tfar inside the grid):
+    // every bundle keeps its base ray exactly.
+    const std::vector<Rayf> adversarial = grid_adversarial_rays(g, scene, rng);
+    const std::vector<Rayf> few(adversarial.begin(),
+                                adversarial.begin() + std::ptrdiff_t(adversarial.size() * std::size_t(bundle_count) / 1600));
+    expect_coherent_walk_matches<K>(*grid, scene, bundles(few, rng, 0.25f * cell, 1e-3f), file + " edge bundles");
+    // Random bundles, tight and loose; loose ones leave the walk on the way.
+    const std::vector<Rayf> random = random_rays(scene, rng, bundle_count, kOriginGrowth);
+    expect_coherent_walk_matches<K>(*grid, scene, bundles(random, rng, 2.0f * cell, 0.01f), file + " bundles");
+    expect_coherent_walk_matches<K>(*grid, scene, bundles(random, rng, 0.0f, 0.6f), file + " fans");
+}
+
+TEST_F(Grid, CoherentWalkMatchesBruteForce) {
+    std::mt19937 rng(37);
+    for (const char* file : {"balls.nff", "mount.nff", "rings.nff", "teapot.nff", "tetra.nff", "tree.nff"}) {
+        if constexpr (kWidthCompiled<4>) expect_coherent_walks<4>(file, rng);
+        if constexpr (kWidthCompiled<8>) expect_coherent_walks<8>(file, rng);
+        if constexpr (kWidthCompiled<16>) expect_coherent_walks<16>(file, rng);
+    }
+}
+
+TEST_F(Grid, CoherentWalkOnASmallScene) {
+    // The test above on one small scene, fewer rays: the sanitizer stage runs this one.
+    std::mt19937 rng(41);
+    if constexpr (kWidthCompiled<4>) expect_coherent_walks<4>("teapot.nff", rng, 20);
+    if constexpr (kWidthCompiled<16>) expect_coherent_walks<16>("teapot.nff", rng, 20);
+}
+
+TEST_F(Grid, DivergingPacketsLeaveTheCoherentWalk) {
+    // 16 rays from the middle of tetra fanning out over a wide cone about
+    // +x: the rectangle outgrows the lanes within a few slices, the walk
+    // hands them over to their own DDAs, and the answers stay brute force's.
+    const Scene scene = load_scene(std::string(RAYPACK_SOURCE_DIR) + "/scenes/tetra.nff");
+    const auto grid = make_grid(scene);
+    const Box3f box = grid->grid().geometry.bounds;
+    std::vector<Rayf> rays;
+    for (int p = 0; p < 64; ++p)
+        for (int l = 0; l < 16; ++l) {
+            Rayf r;
+            r.org = box.lo + box.extent() * Vec3f{0.05f, 0.3f + 0.01f * float(p % 8), 0.3f + 0.01f * float(p / 8)};
+            const float a = 1.2f * (float(l % 4) / 3.0f - 0.5f), b = 1.2f * (float(l / 4) / 3.0f - 0.5f);
+            r.dir = {1.0f, std::tan(a), std::tan(b)};
+            rays.push_back(r);
+        }
+    if constexpr (kWidthCompiled<16>) {
+        const int finished = expect_coherent_walk_matches<16>(*grid, scene, rays, "fan");
+        EXPECT_LT(finished, 64 / 2);  // most packets left the walk
+    }
+    std::vector<Hitf> got(rays.size());
+    grid->intersect_packets(kWidthCompiled<16> ? 16 : 4, rays, got);
+    const BruteForce brute(scene, KernelChoice{});
+    std::size_t n = 0;
+    const std::string first = hit_mismatches(rays, trace(brute, rays), got, n);
+    EXPECT_EQ(n, 0u) << first;
 }
 
 }  // namespace

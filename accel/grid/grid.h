@@ -38,6 +38,10 @@ struct GridConfig {
     /// per-ray hashed form of Wald, "Realtime Ray Tracing and Interactive
     /// Global Illumination", PhD thesis 2004, and Havran's survey).
     bool mailbox = true;
+    /// Packets whose rays share a major direction walk slice by slice
+    /// (coherent grid traversal, coherent_grid.h); false: every packet steps
+    /// each lane's own DDA (dda_packet.h), for comparison and tests.
+    bool coherent_packets = true;
 };
 
 /// What the 3D-DDA needs: the grid's box, resolution and cell size.
@@ -55,14 +59,30 @@ struct GridGeometry {
     float plane(int axis, int i) const { return bounds.lo[axis] + float(i) * cell_size[axis]; }
 };
 
+/// Which blocks of 2^shift x 2^shift x 2^shift cells hold any reference
+/// (macrocells, Parker et al., "Interactive Ray Tracing for Isosurface
+/// Rendering", 1998): the coherent packet walk skips empty blocks whole.
+struct MacroCells {
+    int shift = 2;
+    std::array<int, 3> res{0, 0, 0};
+    std::vector<std::uint8_t> full;  ///< 1 if some cell of the block has references
+
+    bool any(int x, int y, int z) const {
+        return full[std::size_t(x) + std::size_t(res[0]) * (std::size_t(y) + std::size_t(res[1]) * std::size_t(z))];
+    }
+};
+
 struct Grid {
     GridGeometry geometry;
     std::vector<std::uint32_t> cell_begin;  ///< cells() + 1 offsets into refs
     std::vector<std::uint32_t> refs;        ///< primitive numbers, sorted within each cell
     float lambda = 0;                       ///< the density actually used (lowered if references overflowed)
+    MacroCells macro;
 
     bool empty() const { return refs.empty(); }
-    std::size_t bytes() const { return (cell_begin.size() + refs.size()) * sizeof(std::uint32_t); }
+    std::size_t bytes() const {
+        return (cell_begin.size() + refs.size()) * sizeof(std::uint32_t) + macro.full.size();
+    }
 };
 
 /// Resolution for `n` primitives in a box of extent `e`: about lambda * n

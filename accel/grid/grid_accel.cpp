@@ -17,7 +17,10 @@
 namespace raypack {
 
 GridAccel::GridAccel(const Scene& scene, const AccelConfig& config, const GridConfig& grid_config)
-    : scene_(&scene), kernels_(config.kernels), mailbox_(grid_config.mailbox) {
+    : scene_(&scene),
+      kernels_(config.kernels),
+      mailbox_(grid_config.mailbox),
+      coherent_packets_(grid_config.coherent_packets) {
     const auto start = std::chrono::steady_clock::now();
     const std::size_t n = scene.primitive_count();
     std::vector<Box3f> boxes(n);
@@ -113,7 +116,7 @@ bool GridAccel::trace(Rayf& ray, Hitf& hit, GridRayCounters* counters) const {
 template <bool AnyHit>
 void GridAccel::trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
     with_packet_width(width, "grid", [&]<int K>() {
-        grid_trace_packets<K, AnyHit>(grid_, *scene_, kernels_, rays, hits);
+        grid_trace_packets<K, AnyHit>(grid_, *scene_, kernels_, coherent_packets_, rays, hits);
     });
 }
 

@@ -25,9 +25,10 @@ struct GridRayCounters {
     }
 };
 
-/// Packets: K-wide traversal, each lane stepping its own DDA (grid_packet.h).
-/// It has no mailbox: its answers equal those of the single-ray walk with
-/// GridConfig::mailbox off, bit for bit.
+/// Packets (grid_packet.h): coherent packets walk slice by slice (Wald et
+/// al. 2006), the others step each lane's own DDA; the latter have no
+/// mailbox and answer as the single-ray walk with GridConfig::mailbox off,
+/// bit for bit.
 class GridAccel final : public CellAccel<GridAccel, GridRayCounters> {
 public:
     GridAccel(const Scene& scene, const AccelConfig& config, const GridConfig& grid_config = {});
@@ -65,6 +66,7 @@ private:
     Grid grid_;
     std::size_t empty_cells_ = 0;
     bool mailbox_ = true;
+    bool coherent_packets_ = true;
     AccelStats stats_;
 };
 

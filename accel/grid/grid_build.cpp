@@ -178,7 +178,27 @@ Grid build_grid(std::span<const Box3f> boxes, const PrimitiveBoxOverlap* exact, 
         for (std::size_t c = r.begin(); c != r.end(); ++c)
             if (begin[c + 1] - begin[c] > 1) std::sort(grid.refs.begin() + begin[c], grid.refs.begin() + begin[c + 1]);
     });
+    build_macrocells(grid);
     return grid;
+}
+
+void build_macrocells(Grid& grid) {
+    MacroCells& m = grid.macro;
+    const GridGeometry& g = grid.geometry;
+    for (int a = 0; a < 3; ++a) m.res[a] = ((g.res[a] - 1) >> m.shift) + 1;
+    m.full.assign(std::size_t(m.res[0]) * std::size_t(m.res[1]) * std::size_t(m.res[2]), 0);
+    // One layer of blocks per task: no two tasks write the same block.
+    tbb::parallel_for(0, m.res[2], [&](int layer) {
+        const int z1 = std::min(g.res[2], (layer + 1) << m.shift);
+        for (int z = layer << m.shift; z < z1; ++z)
+            for (int y = 0; y < g.res[1]; ++y)
+                for (int x = 0; x < g.res[0]; ++x) {
+                    const std::uint32_t c = g.cell_index(x, y, z);
+                    if (grid.cell_begin[c] == grid.cell_begin[c + 1]) continue;
+                    const std::size_t row = std::size_t(y >> m.shift) + std::size_t(m.res[1]) * std::size_t(layer);
+                    m.full[std::size_t(x >> m.shift) + std::size_t(m.res[0]) * row] = 1;
+                }
+    });
 }
 
 }  // namespace raypack

@@ -18,6 +18,9 @@ namespace raypack {
 /// left out.
 Grid build_grid(std::span<const Box3f> boxes, const PrimitiveBoxOverlap* exact, const GridConfig& config);
 
+/// grid.macro from grid's cells (its shift as set).
+void build_macrocells(Grid& grid);
+
 /// Margin by which cells are widened when primitives are placed: 1e-5 of the
 /// grid's largest extent, plus 8 ulps of its largest coordinate. It covers the
 /// rounding of the DDA (a few ulps of t) for ray origins up to ~20 grid sizes

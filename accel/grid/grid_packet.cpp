@@ -4,6 +4,7 @@
 #include <limits>
 
 #include "accel/cell_kernel_variants.h"
+#include "accel/grid/coherent_grid.h"
 #include "accel/grid/dda_packet.h"
 #include "accel/packet_driver.h"
 #include "accel/packet_intersector.h"
@@ -37,18 +38,13 @@ RAYPACK_INLINE vmask<K> mask_from_bits(std::uint32_t bits) {
 // cells with references, the first one's cell is tested for every lane that
 // stands in it, and those lanes step too. A lane stops where its single-ray
 // walk stops: when its current cell ends past its tfar, or at the grid's
-// boundary (or, for occlusion, at its first hit).
+// boundary (or, for occlusion, at its first hit). `entry`: where each lane
+// starts, inside the grid's box.
 template <int K, bool AnyHit, SlabMethod Slabs>
-void trace_packet(const Grid& grid, const PacketPrimitiveIntersector<vfloat<K>>& isect, RayPacket<K>& ray,
-                  HitPacket<K>& hit, vmask<K> valid, vmask<K>& occluded) {
-    using F = vfloat<K>;
+void dda_walk(const Grid& grid, const PacketPrimitiveIntersector<vfloat<K>>& isect, RayPacket<K>& ray,
+              HitPacket<K>& hit, vmask<K> active, const vfloat<K>& entry, vmask<K>& occluded) {
     using M = vmask<K>;
-    const GridGeometry& g = grid.geometry;
-    const SlabRay<F> slab = make_slab_ray(ray.org, ray.rdir, ray.tnear, ray.tfar);
-    F entry;
-    M active = intersect_box<Slabs, F>(valid, slab, splat<F>(g.bounds.lo), splat<F>(g.bounds.hi), entry);
-    if (none(active)) return;
-    GridDdaPacket<K, Slabs> dda(g, ray, entry);
+    GridDdaPacket<K, Slabs> dda(grid.geometry, ray, entry);
     const std::uint32_t* begin = grid.cell_begin.data();
     const std::uint32_t* refs = grid.refs.data();
     alignas(64) std::int32_t cell[K];
@@ -87,6 +83,15 @@ void trace_packet(const Grid& grid, const PacketPrimitiveIntersector<vfloat<K>>&
     }
 }
 
+/// The lanes of `valid` that meet the grid's box, and their entry distances.
+template <int K, SlabMethod Slabs>
+RAYPACK_INLINE vmask<K> enter_grid(const Grid& grid, const RayPacket<K>& ray, const vmask<K>& valid, vfloat<K>& entry) {
+    const GridGeometry& g = grid.geometry;
+    const SlabRay<vfloat<K>> slab = make_slab_ray(ray.org, ray.rdir, ray.tnear, ray.tfar);
+    return intersect_box<Slabs, vfloat<K>>(valid, slab, splat<vfloat<K>>(g.bounds.lo), splat<vfloat<K>>(g.bounds.hi),
+                                           entry);
+}
+
 }  // namespace
 
 bool grid_packets_exact(const Grid& grid) {
@@ -96,36 +101,46 @@ bool grid_packets_exact(const Grid& grid) {
 }
 
 template <int K, bool AnyHit>
-void grid_trace_packets(const Grid& grid, const Scene& scene, KernelChoice kernels, std::span<const Rayf> rays,
-                        std::span<Hitf> hits) {
+void grid_trace_packets(const Grid& grid, const Scene& scene, KernelChoice kernels, bool coherent,
+                        std::span<const Rayf> rays, std::span<Hitf> hits) {
     using F = vfloat<K>;
     const PacketPrimitiveIntersector<F> isect{&scene, kernels};
     // The slab form is chosen once for all packets, rdir once per packet.
     with_slab_form(kernels.slabs, [&]<SlabMethod Slabs>(SlabTag<Slabs>) {
         trace_in_packets<K, AnyHit>(rays, hits, kernels.rcp, [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid,
-                                                    vmask<K>& occluded) {
+                                                                   vmask<K>& occluded) {
             if (grid.empty()) return;
-            trace_packet<K, AnyHit, Slabs>(grid, isect, ray, hit, valid, occluded);
+            vfloat<K> entry;
+            vmask<K> active = enter_grid<K, Slabs>(grid, ray, valid, entry);
+            if (none(active)) return;
+            // Coherent packets walk slice by slice; packets that are not, or
+            // that diverge on the way, step their lanes' own DDAs.
+            if (coherent) {
+                const int k = coherent_grid::major_axis<K>(ray, active);
+                if (k >= 0 && coherent_grid::trace<K, AnyHit>(grid, isect, k, ray, hit, active, entry, occluded))
+                    return;
+            }
+            dda_walk<K, AnyHit, Slabs>(grid, isect, ray, hit, active, entry, occluded);
         });
     });
 }
 
 #if defined(__SSE4_2__)
-template void grid_trace_packets<4, false>(const Grid&, const Scene&, KernelChoice, std::span<const Rayf>,
+template void grid_trace_packets<4, false>(const Grid&, const Scene&, KernelChoice, bool, std::span<const Rayf>,
                                               std::span<Hitf>);
-template void grid_trace_packets<4, true>(const Grid&, const Scene&, KernelChoice, std::span<const Rayf>,
+template void grid_trace_packets<4, true>(const Grid&, const Scene&, KernelChoice, bool, std::span<const Rayf>,
                                               std::span<Hitf>);
 #endif
 #if defined(__AVX2__)
-template void grid_trace_packets<8, false>(const Grid&, const Scene&, KernelChoice, std::span<const Rayf>,
+template void grid_trace_packets<8, false>(const Grid&, const Scene&, KernelChoice, bool, std::span<const Rayf>,
                                               std::span<Hitf>);
-template void grid_trace_packets<8, true>(const Grid&, const Scene&, KernelChoice, std::span<const Rayf>,
+template void grid_trace_packets<8, true>(const Grid&, const Scene&, KernelChoice, bool, std::span<const Rayf>,
                                               std::span<Hitf>);
 #endif
 #if defined(__AVX512BW__)
-template void grid_trace_packets<16, false>(const Grid&, const Scene&, KernelChoice, std::span<const Rayf>,
+template void grid_trace_packets<16, false>(const Grid&, const Scene&, KernelChoice, bool, std::span<const Rayf>,
                                               std::span<Hitf>);
-template void grid_trace_packets<16, true>(const Grid&, const Scene&, KernelChoice, std::span<const Rayf>,
+template void grid_trace_packets<16, true>(const Grid&, const Scene&, KernelChoice, bool, std::span<const Rayf>,
                                               std::span<Hitf>);
 #endif
 

@@ -1,8 +1,10 @@
 #pragma once
-// Packet traversal of the uniform grid: K rays, each lane stepping its own
-// 3D-DDA (dda_packet.h). Lanes in empty cells step together; a cell with
+// Packet traversal of the uniform grid. Packets whose rays share a major
+// direction walk the grid slice by slice, the whole packet at once
+// (coherent_grid.h, Wald et al. 2006). Other packets step each lane's own
+// 3D-DDA (dda_packet.h): lanes in empty cells step together, and a cell with
 // references is tested once, with the packet kernels, for all the lanes that
-// stand in it, so coherent rays share their primitive tests.
+// stand in it.
 #include <cstdint>
 #include <span>
 
@@ -17,11 +19,14 @@ namespace raypack {
 bool grid_packets_exact(const Grid& grid);
 
 /// Closest hits (AnyHit = false) or occlusion (AnyHit = true, hits[i].prim
-/// = 0 where occluded) of `rays` in packets of K, with the same answers as
-/// the single-ray walk without mailbox, bit for bit. Defined for the K that
-/// are compiled in (see kWidthCompiled).
+/// = 0 where occluded) of `rays` in packets of K. `coherent`: packets whose
+/// rays share a major direction walk slice by slice (coherent_grid.h; the
+/// single-ray walk's answers, ties between primitives at the same t aside);
+/// the others, or all if not `coherent`, step each lane's own DDA, with the
+/// same answers as the single-ray walk without mailbox, bit for bit.
+/// Defined for the K that are compiled in (see kWidthCompiled).
 template <int K, bool AnyHit>
-void grid_trace_packets(const Grid& grid, const Scene& scene, KernelChoice kernels, std::span<const Rayf> rays,
-                        std::span<Hitf> hits);
+void grid_trace_packets(const Grid& grid, const Scene& scene, KernelChoice kernels, bool coherent,
+                        std::span<const Rayf> rays, std::span<Hitf> hits);
 
 }  // namespace raypack
