@@ -7,6 +7,7 @@
 #include "accel/brute/brute_force.h"
 #include "accel/bvh/bvh2_accel.h"
 #include "accel/bvh/wide_bvh_accel.h"
+#include "accel/grid/grid2_accel.h"
 #include "accel/grid/grid_accel.h"
 #include "accel/kdtree/kdtree_accel.h"
 #include "accel/motion/motion_bvh.h"
@@ -28,6 +29,7 @@ std::span<const char* const> accel_kinds() {
         "bvh8",
 #endif
         "grid",
+        "grid2",
         "kdtree",
         "octree",
         "brute",
@@ -167,6 +169,7 @@ std::unique_ptr<Accel> build_one(const Scene& scene, const AccelConfig& config) 
     if (config.kind == "bvh8") return std::make_unique<Bvh8Accel>(scene, config);
 #endif
     if (config.kind == "grid") return std::make_unique<GridAccel>(scene, config);
+    if (config.kind == "grid2") return std::make_unique<Grid2Accel>(scene, config);
     if (config.kind == "kdtree") return std::make_unique<KdTreeAccel>(scene, config);
     if (config.kind == "octree") return std::make_unique<OctreeAccel>(scene, config);
     if (config.kind == "brute") return std::make_unique<BruteForce>(scene, config.kernels);

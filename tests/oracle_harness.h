@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <cstdint>
 #include <iomanip>
 #include <random>
@@ -21,6 +22,7 @@
 #include "kernels/aabb.h"
 #include "render/camera_rays.h"
 #include "scene/scene.h"
+#include "tests/test_paths.h"
 
 namespace raypack::oracle_harness {
 
@@ -86,6 +88,53 @@ inline std::vector<std::uint8_t> trace_occlusion(const Accel& accel, const std::
 
 /// One ray through the centre of every pixel of a size x size image of the
 /// scene's camera, row by row.
+/// Closest hits that agree exactly: same hit or miss; the same primitive at
+/// the bit-identical t; another primitive only at a t within 1e-5 (a shared
+/// edge or vertex, where either is right). The first few that do not, described.
+inline std::string hit_mismatches(const std::vector<Rayf>& rays, const std::vector<Hitf>& want,
+                                  const std::vector<Hitf>& got, std::size_t& count, const char* want_name = "want",
+                                  const char* got_name = "got") {
+    std::string first;
+    count = 0;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        bool ok = want[i].found() == got[i].found();
+        if (ok && want[i].found()) {
+            ok = want[i].prim == got[i].prim
+                     ? want[i].t == got[i].t
+                     : std::fabs(want[i].t - got[i].t) <= 1e-5f * std::max(std::fabs(want[i].t), std::fabs(got[i].t));
+        }
+        if (ok) continue;
+        if (++count <= 5)
+            first += "\n  ray " + std::to_string(i) + ": " + describe(rays[i]) + "\n    " + want_name + " " +
+                     describe(want[i]) + ", " + got_name + " " + describe(got[i]);
+    }
+    return first;
+}
+
+/// Occlusion answers that differ, the first few described.
+inline std::string occlusion_mismatches(const std::vector<Rayf>& rays, const std::vector<std::uint8_t>& want,
+                                        const std::vector<std::uint8_t>& got, std::size_t& count) {
+    std::string first;
+    count = 0;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        if (want[i] == got[i]) continue;
+        if (++count <= 5)
+            first += "\n  ray " + std::to_string(i) + ": " + describe(rays[i]) + "\n    want " +
+                     (want[i] ? "occluded" : "clear") + ", got " + (got[i] ? "occluded" : "clear");
+    }
+    return first;
+}
+
+/// Every scenes/*.nff plus the bunny, found on disk so that new scenes join in.
+inline std::vector<std::string> shared_scene_files() {
+    std::vector<std::string> files;
+    for (const auto& e : std::filesystem::directory_iterator(std::string(RAYPACK_SOURCE_DIR) + "/scenes"))
+        if (e.path().extension() == ".nff") files.push_back(e.path().filename().string());
+    std::sort(files.begin(), files.end());
+    files.push_back("bunny.obj");
+    return files;
+}
+
 inline std::vector<Rayf> camera_rays(const Scene& scene, int size) {
     const CameraFrame f = make_camera_frame(scene.camera, size, size);
     std::vector<Rayf> rays;

@@ -29,15 +29,6 @@ namespace raypack {
 using namespace raypack::oracle_harness;
 namespace {
 
-/// Every scenes/*.nff plus the bunny, found on disk so that new scenes join in.
-std::vector<std::string> scene_files() {
-    std::vector<std::string> files;
-    for (const auto& e : std::filesystem::directory_iterator(std::string(RAYPACK_SOURCE_DIR) + "/scenes"))
-        if (e.path().extension() == ".nff") files.push_back(e.path().filename().string());
-    std::sort(files.begin(), files.end());
-    files.push_back("bunny.obj");
-    return files;
-}
 
 std::vector<std::string> accel_kinds_under_test() {
     std::vector<std::string> kinds = {"bvh2"};
@@ -277,7 +268,7 @@ TEST_P(AccelOracle, MatchesBruteForce) {
 }
 
 // Empty instantiation name: the tests are called AccelOracle.MatchesBruteForce/<scene>.
-INSTANTIATE_TEST_SUITE_P(, AccelOracle, ::testing::ValuesIn(scene_files()), param_name);
+INSTANTIATE_TEST_SUITE_P(, AccelOracle, ::testing::ValuesIn(shared_scene_files()), param_name);
 
 // ---- Hand-made cases that the scenes reach only by luck --------------------------
 

@@ -23,6 +23,7 @@
 #include "accel/embree/embree_accel.h"
 #include "render/camera_rays.h"
 #include "scene/load.h"
+#include "tests/oracle_harness.h"
 
 namespace raypack {
 namespace {
@@ -30,14 +31,6 @@ namespace {
 constexpr double kRequired = 0.999;
 constexpr float kRelT = 1e-4f;
 
-std::vector<std::string> scene_files() {
-    std::vector<std::string> files;
-    for (const auto& e : std::filesystem::directory_iterator(std::string(RAYPACK_SOURCE_DIR) + "/scenes"))
-        if (e.path().extension() == ".nff") files.push_back(e.path().filename().string());
-    std::sort(files.begin(), files.end());
-    files.push_back("bunny.obj");
-    return files;
-}
 
 std::vector<Hitf> trace(const Accel& accel, const std::vector<Rayf>& rays) {
     std::vector<Hitf> hits(rays.size());
@@ -177,7 +170,7 @@ std::string param_name(const ::testing::TestParamInfo<std::string>& info) {
     return s;
 }
 
-INSTANTIATE_TEST_SUITE_P(, EmbreeAgreement, ::testing::ValuesIn(scene_files()), param_name);
+INSTANTIATE_TEST_SUITE_P(, EmbreeAgreement, ::testing::ValuesIn(oracle_harness::shared_scene_files()), param_name);
 
 // ---- Packets: rtcIntersect4/8/16 and rtcOccluded4/8/16 ------------------------------
 

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "tests/oracle_harness.h"
+#include "tests/grid_test_rays.h"
 #include "accel/accel.h"
 #include "accel/brute/brute_force.h"
 #include "accel/grid/coherent_grid.h"
@@ -39,140 +40,8 @@
 namespace raypack::grid_test {
 
 using namespace raypack::oracle_harness;
+using namespace raypack::grid_test_rays;
 namespace {
-
-// ---- Tracing and comparing --------------------------------------------------------
-
-std::vector<Hitf> trace(const Accel& accel, const std::vector<Rayf>& rays) {
-    std::vector<Hitf> hits(rays.size());
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 64), [&](const auto& r) {
-        accel.intersect(std::span<const Rayf>(rays).subspan(r.begin(), r.size()),
-                        std::span<Hitf>(hits).subspan(r.begin(), r.size()));
-    });
-    return hits;
-}
-
-std::vector<std::uint8_t> trace_occluded(const Accel& accel, const std::vector<Rayf>& rays) {
-    std::vector<std::uint8_t> occ(rays.size());
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 64), [&](const auto& r) {
-        accel.occluded(std::span<const Rayf>(rays).subspan(r.begin(), r.size()),
-                       std::span<std::uint8_t>(occ).subspan(r.begin(), r.size()));
-    });
-    return occ;
-}
-
-/// Closest hits that agree exactly: same hit or miss; the same primitive at
-/// the bit-identical t; another primitive only at a t within 1e-5 (a shared
-/// edge or vertex, where either is right).
-std::string hit_mismatches(const std::vector<Rayf>& rays, const std::vector<Hitf>& want, const std::vector<Hitf>& got,
-                           std::size_t& count) {
-    std::string first;
-    count = 0;
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-        bool ok = want[i].found() == got[i].found();
-        if (ok && want[i].found()) {
-            ok = want[i].prim == got[i].prim
-                     ? want[i].t == got[i].t
-                     : std::fabs(want[i].t - got[i].t) <= 1e-5f * std::max(std::fabs(want[i].t), std::fabs(got[i].t));
-        }
-        if (ok) continue;
-        if (++count <= 5)
-            first += "\n  ray " + std::to_string(i) + ": " + describe(rays[i]) + "\n    brute " + describe(want[i]) +
-                     ", grid " + describe(got[i]);
-    }
-    return first;
-}
-
-std::string occlusion_mismatches(const std::vector<Rayf>& rays, const std::vector<std::uint8_t>& want,
-                                 const std::vector<std::uint8_t>& got, std::size_t& count) {
-    std::string first;
-    count = 0;
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-        if (want[i] == got[i]) continue;
-        if (++count <= 5)
-            first += "\n  ray " + std::to_string(i) + ": " + describe(rays[i]) + "\n    brute " +
-                     (want[i] ? "occluded" : "clear") + ", grid " + (got[i] ? "occluded" : "clear");
-    }
-    return first;
-}
-
-/// Closest hit and occlusion of every ray, grid against brute force.
-void expect_agreement(const Scene& scene, const Accel& grid, const std::vector<Rayf>& rays, const std::string& what) {
-    const BruteForce brute(scene, KernelChoice{});
-    const std::vector<Hitf> truth = trace(brute, rays);
-    std::size_t n = 0;
-    const std::string hits = hit_mismatches(rays, truth, trace(grid, rays), n);
-    EXPECT_EQ(n, 0u) << what << ": " << n << " of " << rays.size() << " closest hits differ" << hits;
-    // Brute force finds a closest hit iff some primitive is hit within the
-    // ray's original [tnear, tfar], which is its occlusion answer.
-    std::vector<std::uint8_t> occluded(rays.size());
-    for (std::size_t i = 0; i < rays.size(); ++i) occluded[i] = truth[i].found() ? 1 : 0;
-    const std::string occ = occlusion_mismatches(rays, occluded, trace_occluded(grid, rays), n);
-    EXPECT_EQ(n, 0u) << what << ": " << n << " of " << rays.size() << " occlusion answers differ" << occ;
-}
-
-// ---- Ray sets -----------------------------------------------------------------------
-
-/// random_rays() (tests/oracle_harness.h) draws origins in the scene box
-/// grown by this fraction per side, so that some start outside the structure.
-constexpr float kOriginGrowth = 0.2f;
-
-/// Rays that make a 3D-DDA stumble, built from the grid's own planes.
-std::vector<Rayf> grid_adversarial_rays(const GridGeometry& g, const Scene& scene, std::mt19937& rng) {
-    std::vector<Rayf> rays;
-    const Box3f box = g.bounds;
-    const float diag = length(box.extent());
-    std::uniform_real_distribution<float> u(0, 1);
-    auto plane = [&](int axis) { return g.plane(axis, int(rng() % std::uint32_t(g.res[axis] + 1))); };
-    auto corner = [&] { return Vec3f{plane(0), plane(1), plane(2)}; };
-    // 1. Along cell edges: the two other coordinates exactly on cell planes,
-    //    axis-parallel, from outside the grid.
-    append_edge_rays(rays, rng, box, corner, 600);
-    // 2. Inside a cell plane (that direction component +-0), from inside the grid.
-    append_in_plane_rays(rays, rng, box, plane, 600);
-    // 3. Axis-parallel from random origins in and around the grid; half with a finite tfar.
-    for (int i = 0; i < 600; ++i) {
-        Rayf r;
-        r.org = random_point(rng, grown(box, 0.1f));
-        r.dir = axis_direction(rng, i % 3, (i / 3) % 2 ? 1.0f : -1.0f);
-        if (i % 2) r.tfar = u(rng) * diag;
-        rays.push_back(r);
-    }
-    // 4. Starting inside cells, some from tnear > 0 (the walk begins mid-grid).
-    for (int i = 0; i < 600; ++i) {
-        Rayf r;
-        r.org = random_point(rng, box);
-        r.dir = random_direction(rng);
-        if (i % 2) r.tnear = u(rng) * 0.5f * diag;
-        if (i % 3 == 0) r.tfar = r.tnear + u(rng) * 0.5f * diag;
-        rays.push_back(r);
-    }
-    // 5. Through cell corners, and from cell corners.
-    append_corner_rays(rays, rng, box, corner, 900);
-    // 6. Along cell diagonals: ties between all three axes at every step.
-    for (int i = 0; i < 300; ++i) {
-        Rayf r;
-        Vec3f d = g.cell_size;
-        for (int a = 0; a < 3; ++a)
-            if (rng() % 2) d[a] = -d[a];
-        r.org = corner() - d * float(1 + rng() % 4);
-        r.dir = d;
-        rays.push_back(r);
-    }
-    // 7. From far away (10 grid diagonals), aimed into the grid.
-    for (int i = 0; i < 300; ++i) {
-        Rayf r;
-        const Vec3f target = random_point(rng, box);
-        r.org = target - random_direction(rng) * (10.0f * diag);
-        r.dir = target - r.org;
-        rays.push_back(r);
-    }
-    // 8. On the grid's faces, the far ones included: inwards and along the face.
-    append_face_rays(rays, rng, box, 300);
-    // 9. Aimed at triangle vertices and sphere poles, which lie on cell planes only by chance.
-    append_vertex_rays(rays, scene, rng, grown(box, 0.2f), 300);
-    return rays;
-}
 
 std::unique_ptr<GridAccel> make_grid(const Scene& scene, const GridConfig& gc = {}) {
     return std::make_unique<GridAccel>(scene, AccelConfig{}, gc);
@@ -180,14 +49,6 @@ std::unique_ptr<GridAccel> make_grid(const Scene& scene, const GridConfig& gc = 
 
 // ---- Every shared scene -------------------------------------------------------------
 
-std::vector<std::string> scene_files() {
-    std::vector<std::string> files;
-    for (const auto& e : std::filesystem::directory_iterator(std::string(RAYPACK_SOURCE_DIR) + "/scenes"))
-        if (e.path().extension() == ".nff") files.push_back(e.path().filename().string());
-    std::sort(files.begin(), files.end());
-    files.push_back("bunny.obj");
-    return files;
-}
 
 // One fixture for the whole suite, so that every test is called Grid.*.
 class Grid : public ::testing::TestWithParam<std::string> {};
@@ -231,7 +92,7 @@ TEST_P(Grid, MatchesBruteForce) {
     RecordProperty("refs_per_prim", std::to_string(grid.references_per_primitive()));
 }
 
-INSTANTIATE_TEST_SUITE_P(, Grid, ::testing::ValuesIn(scene_files()), param_name);
+INSTANTIATE_TEST_SUITE_P(, Grid, ::testing::ValuesIn(shared_scene_files()), param_name);
 
 // ---- Hand-made scenes -----------------------------------------------------------------
 
@@ -887,27 +748,6 @@ TEST_F(Grid, MacrocellsMarkExactlyTheOccupiedBlocks) {
         // Both scenes leave blocks empty: the walk has something to skip.
         EXPECT_LT(blocks_full, m.full.size()) << file;
     }
-}
-
-/// Bundles of 16 rays around each base ray that share its major direction:
-/// the base ray itself (unchanged, so the bundle keeps its edge case) and
-/// copies with origins moved by up to `spread_origin` and directions tilted
-/// by up to `spread_dir` radians.
-std::vector<Rayf> bundles(const std::vector<Rayf>& base, std::mt19937& rng, float spread_origin, float spread_dir) {
-    std::uniform_real_distribution<float> u(-1, 1);
-    std::vector<Rayf> rays;
-    for (const Rayf& b : base) {
-        const float len = length(b.dir);
-        for (int l = 0; l < 16; ++l) {
-            Rayf r = b;
-            if (l > 0) {
-                r.org = b.org + Vec3f{u(rng), u(rng), u(rng)} * spread_origin;
-                r.dir = b.dir + Vec3f{u(rng), u(rng), u(rng)} * (spread_dir * len);
-            }
-            rays.push_back(r);
-        }
-    }
-    return rays;
 }
 
 /// Packets of width K through the coherent walk directly, against brute

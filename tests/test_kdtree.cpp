@@ -36,41 +36,6 @@ namespace {
 
 // ---- Tracing and comparing --------------------------------------------------------
 
-/// Closest hits that agree exactly: same hit or miss; the same primitive at
-/// the bit-identical t; another primitive only at a t within 1e-5 (a shared
-/// edge or vertex, where either is right).
-std::string hit_mismatches(const std::vector<Rayf>& rays, const std::vector<Hitf>& want, const std::vector<Hitf>& got,
-                           std::size_t& count) {
-    std::string first;
-    count = 0;
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-        bool ok = want[i].found() == got[i].found();
-        if (ok && want[i].found()) {
-            ok = want[i].prim == got[i].prim
-                     ? want[i].t == got[i].t
-                     : std::fabs(want[i].t - got[i].t) <= 1e-5f * std::max(std::fabs(want[i].t), std::fabs(got[i].t));
-        }
-        if (ok) continue;
-        if (++count <= 5)
-            first += "\n  ray " + std::to_string(i) + ": " + describe(rays[i]) + "\n    brute " + describe(want[i]) +
-                     ", kdtree " + describe(got[i]);
-    }
-    return first;
-}
-
-std::string occlusion_mismatches(const std::vector<Rayf>& rays, const std::vector<std::uint8_t>& want,
-                                 const std::vector<std::uint8_t>& got, std::size_t& count) {
-    std::string first;
-    count = 0;
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-        if (want[i] == got[i]) continue;
-        if (++count <= 5)
-            first += "\n  ray " + std::to_string(i) + ": " + describe(rays[i]) + "\n    want " +
-                     (want[i] ? "occluded" : "clear") + ", got " + (got[i] ? "occluded" : "clear");
-    }
-    return first;
-}
-
 /// Packets of every compiled width against single rays: the same kernels per
 /// lane, so the same primitive, t, u and v bit for bit, and the same occlusion.
 void expect_packets_equal_single(const Accel& tree, const std::vector<Rayf>& rays, const std::vector<Hitf>& single,
@@ -320,14 +285,6 @@ void expect_well_formed(const KdTreeAccel& accel, const Scene& scene) {
 
 // ---- Every shared scene -------------------------------------------------------------
 
-std::vector<std::string> scene_files() {
-    std::vector<std::string> files;
-    for (const auto& e : std::filesystem::directory_iterator(std::string(RAYPACK_SOURCE_DIR) + "/scenes"))
-        if (e.path().extension() == ".nff") files.push_back(e.path().filename().string());
-    std::sort(files.begin(), files.end());
-    files.push_back("bunny.obj");
-    return files;
-}
 
 // One fixture for the whole suite, so that every test is called KdTree.*.
 class KdTree : public ::testing::TestWithParam<std::string> {};
@@ -370,7 +327,7 @@ TEST_P(KdTree, MatchesBruteForce) {
     RecordProperty("refs_per_prim", std::to_string(tree.references_per_primitive()));
 }
 
-INSTANTIATE_TEST_SUITE_P(, KdTree, ::testing::ValuesIn(scene_files()), param_name);
+INSTANTIATE_TEST_SUITE_P(, KdTree, ::testing::ValuesIn(shared_scene_files()), param_name);
 
 // ---- Hand-made scenes -----------------------------------------------------------------
 

@@ -64,38 +64,6 @@ std::vector<std::uint8_t> trace_occluded(const Accel& accel, const std::vector<R
     return occ;
 }
 
-std::string hit_mismatches(const std::vector<Rayf>& rays, const std::vector<Hitf>& want, const std::vector<Hitf>& got,
-                           std::size_t& count, const char* want_name, const char* got_name) {
-    std::string first;
-    count = 0;
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-        bool ok = want[i].found() == got[i].found();
-        if (ok && want[i].found()) {
-            ok = want[i].prim == got[i].prim
-                     ? want[i].t == got[i].t
-                     : std::fabs(want[i].t - got[i].t) <= 1e-5f * std::max(std::fabs(want[i].t), std::fabs(got[i].t));
-        }
-        if (ok) continue;
-        if (++count <= 5)
-            first += "\n  ray " + std::to_string(i) + ": " + describe(rays[i]) + "\n    " + want_name + " " +
-                     describe(want[i]) + ", " + got_name + " " + describe(got[i]);
-    }
-    return first;
-}
-
-std::string occlusion_mismatches(const std::vector<Rayf>& rays, const std::vector<std::uint8_t>& want,
-                                 const std::vector<std::uint8_t>& got, std::size_t& count) {
-    std::string first;
-    count = 0;
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-        if (want[i] == got[i]) continue;
-        if (++count <= 5)
-            first += "\n  ray " + std::to_string(i) + ": " + describe(rays[i]) + "\n    want " +
-                     (want[i] ? "occluded" : "clear") + ", got " + (got[i] ? "occluded" : "clear");
-    }
-    return first;
-}
-
 std::vector<int> packet_widths() {
     std::vector<int> w;
     if constexpr (kWidthCompiled<4>) w.push_back(4);
@@ -278,14 +246,6 @@ void expect_well_formed(const OctreeAccel& accel, const Scene& scene, const Octr
 
 // ---- Every shared scene -------------------------------------------------------------
 
-std::vector<std::string> scene_files() {
-    std::vector<std::string> files;
-    for (const auto& e : std::filesystem::directory_iterator(std::string(RAYPACK_SOURCE_DIR) + "/scenes"))
-        if (e.path().extension() == ".nff") files.push_back(e.path().filename().string());
-    std::sort(files.begin(), files.end());
-    files.push_back("bunny.obj");
-    return files;
-}
 
 // One fixture for the whole suite, so that every test is called Octree.*.
 class Octree : public ::testing::TestWithParam<std::string> {};
@@ -317,7 +277,7 @@ TEST_P(Octree, MatchesBruteForce) {
     RecordProperty("refs_per_prim", std::to_string(octree.references_per_primitive()));
 }
 
-INSTANTIATE_TEST_SUITE_P(, Octree, ::testing::ValuesIn(scene_files()), param_name);
+INSTANTIATE_TEST_SUITE_P(, Octree, ::testing::ValuesIn(shared_scene_files()), param_name);
 
 // ---- Hand-made scenes -----------------------------------------------------------------
 

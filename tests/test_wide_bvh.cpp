@@ -40,14 +40,6 @@ namespace raypack::wide_bvh_test {
 using namespace raypack::oracle_harness;
 namespace {
 
-std::vector<std::string> scene_files() {
-    std::vector<std::string> files;
-    for (const auto& e : std::filesystem::directory_iterator(std::string(RAYPACK_SOURCE_DIR) + "/scenes"))
-        if (e.path().extension() == ".nff") files.push_back(e.path().filename().string());
-    std::sort(files.begin(), files.end());
-    files.push_back("bunny.obj");
-    return files;
-}
 
 std::vector<Hitf> trace(const Accel& accel, const std::vector<Rayf>& rays) {
     std::vector<Hitf> hits(rays.size());
@@ -387,7 +379,7 @@ TEST_P(WideBvh, MatchesBruteForce) {
     check_against_oracle(scene, KernelChoice{}, big ? 40 : 64, big ? 1000 : 2000, GetParam());
 }
 
-INSTANTIATE_TEST_SUITE_P(, WideBvh, ::testing::ValuesIn(scene_files()), param_name);
+INSTANTIATE_TEST_SUITE_P(, WideBvh, ::testing::ValuesIn(shared_scene_files()), param_name);
 
 // The other kernels change the leaf layout (vertices instead of edges) and
 // the sphere test: checked on the scenes with every primitive kind.

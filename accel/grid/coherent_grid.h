@@ -101,13 +101,15 @@ RAYPACK_INLINE int major_axis(const RayPacket<K>& ray, const vmask<K>& active) {
 inline constexpr int kMaxCellsPerLane = 2;
 
 /// Walks the active lanes through the grid slice by slice along axis k
-/// (from major_axis), from each lane's `entry` distance into the grid's box.
-/// AnyHit: lanes that hit are added to `occluded` and stop. Returns true
-/// when the packet is done; false when its rays diverged, with `active` the
-/// lanes still walking and `entry` where each should go on with its own DDA.
-template <int K, bool AnyHit>
-bool trace(const Grid& grid, const PacketPrimitiveIntersector<vfloat<K>>& isect, int k, RayPacket<K>& ray,
-           HitPacket<K>& hit, vmask<K>& active, vfloat<K>& entry, vmask<K>& occluded) {
+/// (from major_axis), from each lane's `entry` distance into the grid's box,
+/// calling `visit_cell(c)` for each non-empty cell c met, which tests what
+/// the cell holds against the active lanes and returns true once no lane is
+/// left (any hit). Returns true when the packet is done; false when its rays
+/// diverged, with `active` the lanes still walking and `entry` where each
+/// should go on alone.
+template <int K, class VisitCell>
+bool walk(const Grid& grid, int k, const RayPacket<K>& ray, vmask<K>& active, vfloat<K>& entry,
+          VisitCell&& visit_cell) {
     using F = vfloat<K>;
     const GridGeometry& g = grid.geometry;
     const MacroCells& macro = grid.macro;
@@ -136,11 +138,6 @@ bool trace(const Grid& grid, const PacketPrimitiveIntersector<vfloat<K>>& isect,
 
     const std::int32_t stride[3] = {1, g.res[0], g.res[0] * g.res[1]};
     const std::uint32_t* begin = grid.cell_begin.data();
-    const std::uint32_t* refs = grid.refs.data();
-    // Mailbox of the primitives already tested against the packet, direct-mapped.
-    constexpr std::uint32_t kMailboxSize = 128;
-    alignas(64) std::uint32_t mailbox[kMailboxSize];
-    std::fill(mailbox, mailbox + kMailboxSize, kNoPrim);
 
     const F org_k = ray.org[k], rdir_k = ray.rdir[k];
     // Distance of each lane to the plane between slices i - 1 and i.
@@ -219,22 +216,8 @@ bool trace(const Grid& grid, const PacketPrimitiveIntersector<vfloat<K>>& isect,
             const std::uint32_t* row = begin + s * stride[k] + first[1] * stride[v] + first[0] * stride[u];
             for (int j = first[1]; j <= last[1]; ++j, row += stride[v]) {
                 const std::uint32_t* cell = row;
-                for (int i = first[0]; i <= last[0]; ++i, cell += stride[u]) {
-                    for (std::uint32_t r = cell[0], r_end = cell[1]; r < r_end; ++r) {
-                        const std::uint32_t prim = refs[r];
-                        std::uint32_t& slot = mailbox[prim & (kMailboxSize - 1)];
-                        if (slot == prim) continue;
-                        slot = prim;
-                        const vmask<K> m = isect.intersect(active, ray, hit, prim);
-                        if constexpr (AnyHit) {
-                            if (any(m)) {
-                                occluded = occluded | m;
-                                active = active & !m;
-                                if (none(active)) return true;
-                            }
-                        }
-                    }
-                }
+                for (int i = first[0]; i <= last[0]; ++i, cell += stride[u])
+                    if (cell[0] != cell[1] && visit_cell(std::uint32_t(cell - begin))) return true;
             }
             if (stop_before(up ? s + 1 : s)) return true;
             if (s == block_end) break;
@@ -242,6 +225,36 @@ bool trace(const Grid& grid, const PacketPrimitiveIntersector<vfloat<K>>& isect,
         s = block_end + step;
     }
     return true;
+}
+
+/// walk() testing each cell's primitives against the active lanes, each
+/// primitive once per packet (a direct-mapped mailbox). AnyHit: lanes that
+/// hit are added to `occluded` and stop.
+template <int K, bool AnyHit>
+bool trace(const Grid& grid, const PacketPrimitiveIntersector<vfloat<K>>& isect, int k, RayPacket<K>& ray,
+           HitPacket<K>& hit, vmask<K>& active, vfloat<K>& entry, vmask<K>& occluded) {
+    constexpr std::uint32_t kMailboxSize = 128;
+    alignas(64) std::uint32_t mailbox[kMailboxSize];
+    std::fill(mailbox, mailbox + kMailboxSize, kNoPrim);
+    const std::uint32_t* begin = grid.cell_begin.data();
+    const std::uint32_t* refs = grid.refs.data();
+    return walk<K>(grid, k, ray, active, entry, [&](std::uint32_t c) RAYPACK_INLINE_LAMBDA {
+        for (std::uint32_t r = begin[c], r_end = begin[c + 1]; r < r_end; ++r) {
+            const std::uint32_t prim = refs[r];
+            std::uint32_t& slot = mailbox[prim & (kMailboxSize - 1)];
+            if (slot == prim) continue;
+            slot = prim;
+            const vmask<K> m = isect.intersect(active, ray, hit, prim);
+            if constexpr (AnyHit) {
+                if (any(m)) {
+                    occluded = occluded | m;
+                    active = active & !m;
+                    if (none(active)) return true;
+                }
+            }
+        }
+        return false;
+    });
 }
 
 }  // namespace raypack::coherent_grid

@@ -42,6 +42,9 @@ struct GridConfig {
     /// (coherent grid traversal, coherent_grid.h); false: every packet steps
     /// each lane's own DDA (dda_packet.h), for comparison and tests.
     bool coherent_packets = true;
+    /// Cells are widened by at least this much when primitives are placed
+    /// (grid_build.h); a sub-grid of a two-level grid takes its parent's.
+    float min_placement_margin = 0.0f;
 };
 
 /// What the 3D-DDA needs: the grid's box, resolution and cell size.

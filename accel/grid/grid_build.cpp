@@ -147,7 +147,7 @@ Grid build_grid(std::span<const Box3f> boxes, const PrimitiveBoxOverlap* exact, 
     const std::uint64_t max_refs =
         std::min<std::uint64_t>(config.max_references, std::numeric_limits<std::uint32_t>::max() - 1);
     std::array<int, 3> res = grid_resolution(bounds.extent(), n, config.lambda, max_cells);
-    const float margin = grid_placement_margin(bounds);
+    const float margin = std::max(grid_placement_margin(bounds), config.min_placement_margin);
     std::vector<std::uint32_t>& begin = grid.cell_begin;
     std::uint64_t total = 0;
     for (;;) {

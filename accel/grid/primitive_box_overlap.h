@@ -13,13 +13,16 @@ namespace raypack {
 
 struct PrimitiveBoxOverlap {
     const Scene* scene;
+    /// If set, the callers' primitive numbers index this table of the
+    /// scene's (a sub-grid built over some of the primitives).
+    const std::uint32_t* ids = nullptr;
 
     /// True if the primitive may meet the closed box [lo, hi]: triangles by
     /// the separating axis test, spheres by the distance from the centre to
     /// the box (Arvo, "A Simple Method for Box-Sphere Intersection Testing",
     /// Graphics Gems 1990), cones by their bounding box only.
     bool overlaps(std::uint32_t prim, const Vec3d& lo, const Vec3d& hi) const {
-        const PrimRef ref = scene->prims[prim];
+        const PrimRef ref = scene->prims[ids ? ids[prim] : prim];
         const std::uint32_t i = ref.index;
         switch (ref.kind) {
             case PrimKind::Triangle: {

@@ -1,0 +1,43 @@
+#pragma once
+// Two-level grid (`--accel grid2`, two_level_grid.h): single rays walk the
+// top grid's cells with a 3D-DDA and, in each non-empty cell, that cell's
+// own grid over the same stretch of the ray; coherent packets walk both
+// levels slice by slice (coherent_grid.h).
+#include <cstdint>
+
+#include "accel/cell_accel.h"
+#include "accel/grid/grid_accel.h"
+#include "accel/grid/two_level_grid.h"
+#include "accel/packet_intersector.h"
+#include "kernels/ray_packet.h"
+
+namespace raypack {
+
+class Grid2Accel final : public CellAccel<Grid2Accel, GridRayCounters> {
+public:
+    Grid2Accel(const Scene& scene, const AccelConfig& config, const TwoLevelGridConfig& grid_config = {});
+    const AccelStats& stats() const override { return stats_; }
+    const TwoLevelGrid& grid() const { return grid_; }
+
+private:
+    friend class CellAccel<Grid2Accel, GridRayCounters>;
+    template <bool AnyHit>
+    void trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const;
+    template <int K, bool AnyHit, SlabMethod Slabs>
+    void trace_packet(const PacketPrimitiveIntersector<vfloat<K>>& isect, RayPacket<K>& ray, HitPacket<K>& hit,
+                      vmask<K> valid, vmask<K>& occluded) const;
+    template <bool AnyHit, bool Counting, SlabMethod Slabs>
+    bool walk(Rayf& ray, Hitf& hit, GridRayCounters* counters) const;
+    bool packets_exact() const { return packets_exact_; }
+    SlabMethod slab_method() const { return kernels_.slabs; }
+
+    const Scene* scene_;
+    KernelChoice kernels_;
+    TwoLevelGrid grid_;
+    bool packets_exact_ = true;  ///< every grid's counters are exact in floats (grid_packet.h)
+    AccelStats stats_;
+};
+
+extern template class CellAccel<Grid2Accel, GridRayCounters>;  // grid2_accel.cpp
+
+}  // namespace raypack
