@@ -9,7 +9,7 @@
 // The per-lane 3D-DDA (dda_packet.h) steps every lane through its own cells;
 // here the stepping is shared and only the rectangle is per slice.
 //
-// Included only by grid_packet.cpp.
+// Included only by grid_packet.cpp and grid2_accel.cpp.
 //
 // Exactness: every primitive in a cell some active lane's segment crosses
 // is tested against every active lane, over the lane's whole [tnear, tfar],
