@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include "tests/test_paths.h"
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <bit>
@@ -337,6 +338,34 @@ Scene scene_with(const std::function<void(Scene&)>& add) {
     add(s);
     s.update_features();
     return s;
+}
+
+TEST_F(KdTree, SameTreeForAnyThreadCount) {
+    // Subtrees of more than 4096 primitives near the root are built in
+    // parallel and spliced in the serial order (kdtree_build.cpp): the tree
+    // must come out the same with one thread and with two, its SAH cost to
+    // the last bit. gen:mount:7 (32k triangles) takes the parallel path.
+    const Scene scene = load_scene("gen:mount:7");
+    auto build_with = [&](int threads) {
+        tbb::task_arena arena(threads);
+        std::unique_ptr<KdTreeAccel> accel;
+        arena.execute([&] { accel = std::make_unique<KdTreeAccel>(scene, AccelConfig{}); });
+        return accel;
+    };
+    const auto one = build_with(1), two = build_with(2);
+    const raypack::KdTree &a = one->tree(), &b = two->tree();
+    ASSERT_EQ(a.nodes.size(), b.nodes.size());
+    for (std::size_t i = 0; i < a.nodes.size(); ++i) {
+        ASSERT_EQ(a.nodes[i].word, b.nodes[i].word) << "node " << i;
+        ASSERT_EQ(a.nodes[i].bits, b.nodes[i].bits) << "node " << i;
+    }
+    EXPECT_EQ(a.prim_index, b.prim_index);
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(a.sah_cost), std::bit_cast<std::uint64_t>(b.sah_cost));
+    EXPECT_EQ(a.depth, b.depth);
+    EXPECT_EQ(a.leaves, b.leaves);
+    EXPECT_EQ(a.empty_leaves, b.empty_leaves);
+    EXPECT_EQ(a.references, b.references);
+    EXPECT_GT(scene.primitive_count(), 4096u);
 }
 
 TEST_F(KdTree, RegisteredAsAnAccelKind) {

@@ -1,5 +1,7 @@
 #include "accel/kdtree/kdtree_build.h"
 
+#include <tbb/parallel_invoke.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -130,10 +132,51 @@ public:
         std::vector<Event>().swap(right_only);
         std::vector<Event>().swap(right_new);
 
-        build(std::move(left), n_left, left_voxel, depth + 1, tree);
-        const std::uint32_t above = build(std::move(right), n_right, right_voxel, depth + 1, tree);
+        std::uint32_t above;
+        if (n > kParallelPrims && depth < kParallelDepth) {
+            // The two subtrees at once, each into a tree of its own (the
+            // right one with its own copy of the side marks), spliced in the
+            // serial order: the same tree for any number of threads.
+            KdTree below_part, above_part;
+            Builder right_builder(*this);
+            tbb::parallel_invoke(
+                [&] { build(std::move(left), n_left, left_voxel, depth + 1, below_part); },
+                [&] { right_builder.build(std::move(right), n_right, right_voxel, depth + 1, above_part); });
+            splice(below_part, tree);
+            above = splice(above_part, tree);
+        } else {
+            build(std::move(left), n_left, left_voxel, depth + 1, tree);
+            above = build(std::move(right), n_right, right_voxel, depth + 1, tree);
+        }
         tree.nodes[index] = KdNode::inner(plane.axis, plane.pos, above);
         return index;
+    }
+
+    /// Subtrees of more primitives than this within this many levels of the
+    /// root are built in parallel (at most 2^kParallelDepth - 1 copies of the
+    /// side marks, one byte per primitive each).
+    static constexpr std::size_t kParallelPrims = 4096;
+    static constexpr int kParallelDepth = 4;
+
+    /// Appends `part` (a subtree built on its own, root at 0) to `tree`;
+    /// returns the index of its root there.
+    static std::uint32_t splice(const KdTree& part, KdTree& tree) {
+        const std::size_t base = tree.nodes.size(), prim_base = tree.prim_index.size();
+        if (base + part.nodes.size() >= (std::size_t(1) << 30) ||
+            prim_base + part.prim_index.size() >= (std::size_t(1) << 32) - 1)
+            throw std::length_error("kdtree: more than 2^30 nodes or 2^32 references");
+        for (KdNode node : part.nodes) {
+            if (!node.is_leaf()) node = KdNode::inner(node.axis(), node.split(), node.above_child() + std::uint32_t(base));
+            else if (node.prim_count() > 1) node = KdNode::leaf(node.prim_count(), node.word + std::uint32_t(prim_base));
+            tree.nodes.push_back(node);
+        }
+        tree.prim_index.insert(tree.prim_index.end(), part.prim_index.begin(), part.prim_index.end());
+        tree.depth = std::max(tree.depth, part.depth);
+        tree.leaves += part.leaves;
+        tree.empty_leaves += part.empty_leaves;
+        tree.references += part.references;
+        tree.sah_cost += part.sah_cost;
+        return std::uint32_t(base);
     }
 
     int max_depth_ = 0;
