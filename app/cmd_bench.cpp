@@ -14,11 +14,13 @@
 #include "accel/bvh/bvh_builders.h"
 #include "app/scene_options.h"
 #include "app/accel_options.h"
+#include "app/bench_html.h"
 #include "app/bench_measure.h"
 #include "app/bench_report.h"
 #include "app/bench_tradeoff.h"
 #include "app/commands.h"
 #include "app/variant_options.h"
+#include "measure/cost_map.h"
 #include "scene/load.h"
 
 namespace raypack::app {
@@ -89,8 +91,8 @@ void print_help() {
     std::printf(
         "usage: raypack bench [SCENE...] [--accel LIST] [--packet LIST] [--rays KINDS | --rays-file FILE]\n"
         "                     [--threads LIST] [--repeat R] [--res W H] [--offset POLICY] [--json FILE] [--csv FILE]\n"
-        "                     [--builder B] [--triangle T] [--sphere S] [--slabs S] [--precision P] [--rcp R]\n"
-        "                     [--quick]\n"
+        "                     [--report FILE.html] [--builder B] [--triangle T] [--sphere S] [--slabs S]\n"
+        "                     [--precision P] [--rcp R] [--quick]\n"
         "       raypack bench --tradeoff [--quick] [--repeat R] [--json FILE] [--csv FILE]\n"
         "  SCENE          .nff, .obj or gen:NAME:SIZE (default gen:balls:4)\n"
         "  --accel LIST   comma-separated, from %s (default: all but brute,\n"
@@ -103,6 +105,8 @@ void print_help() {
         "  --repeat R     timed passes after one warm-up; median, min and max reported (default 5)\n"
         "  --res W H      image size of the generated ray sets (default 512 512)\n"
         "  --json FILE    one object per row; --csv FILE: the same columns (schema: docs/bench.md)\n"
+        "  --report FILE  one self-contained HTML page: the tables, a chart per scene and ray kind, the\n"
+        "                 camera rays' cost heat maps, Havran's measures beside Havran and Sixta's (1999)\n"
         "  --quick        every structure (brute too), width and ray kind on gen:balls:3 at 256x256,\n"
         "                 repeat 3: the CI smoke run; explicit options still apply\n"
         "  --offset P     secondary-ray origins of the shadow and diffuse sets: %s (default %s)\n"
@@ -215,7 +219,7 @@ std::size_t count_cases(const BenchPlan& plan) {
 int run_bench(const Args& args) {
     std::vector<OptionSpec> specs = {{"--accel", "", 1}, {"--packet", "", 1}, {"--rays", "", 1},
                                      {"--rays-file", "", 1}, {"--threads", "", 1}, {"--repeat", "", 1},
-                                     {"--res", "", 2}, {"--json", "", 1}, {"--csv", "", 1}, {"--quick", "", 0},
+                                     {"--res", "", 2}, {"--json", "", 1}, {"--csv", "", 1}, {"--report", "", 1}, {"--quick", "", 0},
                                      {"--tradeoff", "", 0}, {"--builder", "", 1}, {"--embree-quality", "", 1},
                                      offset_option_spec()};
     for (OptionSpec& k : kernel_option_specs()) specs.push_back(std::move(k));
@@ -227,7 +231,7 @@ int run_bench(const Args& args) {
     }
     if (p.has("--tradeoff")) {
         for (const char* other : {"--accel", "--packet", "--rays", "--rays-file", "--threads", "--res", "--offset",
-                                  "--builder", "--sphere", "--triangle", "--slabs", "--precision", "--rcp",
+                                  "--report", "--builder", "--sphere", "--triangle", "--slabs", "--precision", "--rcp",
                                   "--embree-quality"})
             if (p.has(other)) throw UsageError(std::string(other) + " does not apply to --tradeoff (it runs every variant)");
         if (!p.positional().empty()) throw UsageError("--tradeoff takes no SCENE (it builds its own)");
@@ -236,6 +240,11 @@ int run_bench(const Args& args) {
                                          .json = p.text("--json"), .csv = p.text("--csv")});
     }
     const BenchPlan plan = plan_from(p);
+    BenchHtmlContext html;
+    if (p.has("--report")) {
+        for (const std::string& t : args.tokens) html.command += (html.command.empty() ? "" : " ") + t;
+        html.machine = processor_name();
+    }
     Progress progress(count_cases(plan));
     std::vector<BenchRow> rows;
     std::vector<std::string> skipped;
@@ -258,6 +267,12 @@ int run_bench(const Args& args) {
         for (const std::string& accel_kind : plan.accels) {
             const auto accel = build_accel(scene, plan.config(accel_kind));
             const AccelStats& stats = accel->stats();
+            if (p.has("--report") && !is_embree_kind(accel_kind) && accel_kind != "brute") {
+                // The report's heat map: small, so that the page stays light.
+                constexpr int kMapSize = 128;
+                html.maps.push_back({scene_name, stats.name,
+                                     cost_heat_map(primary_ray_cost(scene, *accel, kMapSize, kMapSize))});
+            }
             const std::vector<int> widths = packet_widths(plan, *accel, skipped);
             for (std::size_t s = 0; s < sets.size(); ++s) {
                 const BenchRays& set = sets[s];
@@ -312,6 +327,7 @@ int run_bench(const Args& args) {
     }
     if (p.has("--json")) write_bench_json(p.text("--json"), rows);
     if (p.has("--csv")) write_bench_csv(p.text("--csv"), rows);
+    if (p.has("--report")) write_bench_html(p.text("--report"), rows, html);
     std::fprintf(stderr, "raypack bench: %zu rows in %.1f s\n", rows.size(), progress.elapsed());
     return 0;
 }

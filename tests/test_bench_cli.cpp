@@ -57,6 +57,46 @@ const char* const kRequiredFields[] = {"scene",           "accel",           "pa
                                        "n_ts",            "n_ets",           "n_eets",       "memory_bytes",
                                        "validated"};
 
+TEST(BenchCli, ReportIsOneSelfContainedPageThatABrowserRenders) {
+    // `--report`: one HTML file, nothing fetched from anywhere (every picture
+    // a data URI, no scripts or styles from files), its tables and one cost
+    // map per counting structure; then Debian's chromium (installed by
+    // scripts/setup) opens it headless and every picture must decode.
+    const fs::path html = temp_dir() / "report.html";
+    fs::remove(html);
+    const std::string scene = std::string(RAYPACK_SOURCE_DIR) + "/scenes/teapot.nff";
+    const BenchRun run = run_bench(scene + " --accel bvh2,grid,octree --packet 1 --rays camera,shadow --res 24 24" +
+                                   " --repeat 1 --report " + html.string());
+    ASSERT_EQ(run.status, 0) << run.output;
+    std::ifstream in(html);
+    const std::string page((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    auto count = [&](const std::string& what) {
+        std::size_t n = 0;
+        for (std::size_t at = page.find(what); at != std::string::npos; at = page.find(what, at + 1)) ++n;
+        return n;
+    };
+    EXPECT_EQ(page.rfind("<!doctype html>", 0), 0u);
+    EXPECT_EQ(count("<img"), 3u);  // bvh2, grid, octree
+    EXPECT_EQ(count("src=\"data:image/bmp;base64,"), 3u);
+    EXPECT_EQ(count("src="), 3u);  // nothing else to load
+    EXPECT_EQ(count("http"), 0u);
+    EXPECT_EQ(count("<table class=\"best\">"), 2u);  // camera and shadow rays
+    EXPECT_EQ(count("<svg"), 2u);
+    EXPECT_EQ(count("<table class=\"havran\">"), 1u);
+    // Havran and Sixta's uniform grid and octree on teapot.
+    EXPECT_NE(page.find("13.30 / 41.24 / 41.24 / 38.08"), std::string::npos);
+    EXPECT_NE(page.find("40.02 / 83.40 / 13.75 / 9.53"), std::string::npos);
+    const fs::path dom = temp_dir() / "dom.html";
+    const std::string browser = "chromium --headless --no-sandbox --disable-gpu --dump-dom file://" + html.string() +
+                                " >" + dom.string() + " 2>/dev/null";
+    ASSERT_EQ(std::system("command -v chromium >/dev/null"), 0) << "chromium is missing (scripts/setup installs it)";
+    ASSERT_EQ(std::system(("timeout 120 " + browser).c_str()), 0);
+    std::ifstream dumped(dom);
+    const std::string rendered((std::istreambuf_iterator<char>(dumped)), std::istreambuf_iterator<char>());
+    EXPECT_NE(rendered.find("data-images-ok=\"3/3\""), std::string::npos) << rendered.substr(0, 400);
+    EXPECT_NE(rendered.find("<table class=\"rows\">"), std::string::npos);
+}
+
 TEST(BenchCli, QuickRunValidatesEveryStructureWidthAndRayKind) {
     const fs::path json = temp_dir() / "quick.json", csv = temp_dir() / "quick.csv";
     fs::remove(json);
