@@ -87,8 +87,10 @@ TEST(BenchCli, ReportIsOneSelfContainedPageThatABrowserRenders) {
     EXPECT_NE(page.find("13.30 / 41.24 / 41.24 / 38.08"), std::string::npos);
     EXPECT_NE(page.find("40.02 / 83.40 / 13.75 / 9.53"), std::string::npos);
     const fs::path dom = temp_dir() / "dom.html";
-    const std::string browser = "chromium --headless --no-sandbox --disable-gpu --dump-dom file://" + html.string() +
-                                " >" + dom.string() + " 2>/dev/null";
+    // A profile of its own: CI runs as root, perhaps without a writable home.
+    const std::string browser = "chromium --headless --no-sandbox --disable-gpu --user-data-dir=" +
+                                (temp_dir() / "profile").string() + " --dump-dom file://" + html.string() + " >" +
+                                dom.string() + " 2>/dev/null";
     ASSERT_EQ(std::system("command -v chromium >/dev/null"), 0) << "chromium is missing (scripts/setup installs it)";
     ASSERT_EQ(std::system(("timeout 120 " + browser).c_str()), 0);
     std::ifstream dumped(dom);
