@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
+#include <stdexcept>
 
 #include "accel/bvh/bvh_builders.h"
 #include "app/scene_options.h"
@@ -219,8 +220,8 @@ std::size_t count_cases(const BenchPlan& plan) {
 int run_bench(const Args& args) {
     std::vector<OptionSpec> specs = {{"--accel", "", 1}, {"--packet", "", 1}, {"--rays", "", 1},
                                      {"--rays-file", "", 1}, {"--threads", "", 1}, {"--repeat", "", 1},
-                                     {"--res", "", 2}, {"--json", "", 1}, {"--csv", "", 1}, {"--report", "", 1}, {"--quick", "", 0},
-                                     {"--tradeoff", "", 0}, {"--builder", "", 1}, {"--embree-quality", "", 1},
+                                     {"--res", "", 2}, {"--json", "", 1}, {"--csv", "", 1}, {"--report", "", 1},
+                                     {"--quick", "", 0}, {"--tradeoff", "", 0}, {"--builder", "", 1}, {"--embree-quality", "", 1},
                                      offset_option_spec()};
     for (OptionSpec& k : kernel_option_specs()) specs.push_back(std::move(k));
     for (OptionSpec& k : scene_option_specs()) specs.push_back(std::move(k));
@@ -242,7 +243,8 @@ int run_bench(const Args& args) {
     const BenchPlan plan = plan_from(p);
     BenchHtmlContext html;
     if (p.has("--report")) {
-        for (const std::string& t : args.tokens) html.command += (html.command.empty() ? "" : " ") + t;
+        html.command = "raypack bench";
+        for (const std::string& t : args.tokens) html.command += " " + t;
         html.machine = processor_name();
     }
     Progress progress(count_cases(plan));
@@ -269,9 +271,13 @@ int run_bench(const Args& args) {
             const AccelStats& stats = accel->stats();
             if (p.has("--report") && !is_embree_kind(accel_kind) && accel_kind != "brute") {
                 // The report's heat map: small, so that the page stays light.
+                // Structures that cannot count (instanced or moving scenes) have none.
                 constexpr int kMapSize = 128;
-                html.maps.push_back({scene_name, stats.name,
-                                     cost_heat_map(primary_ray_cost(scene, *accel, kMapSize, kMapSize))});
+                try {
+                    html.maps.push_back({scene_name, stats.name,
+                                         cost_heat_map(primary_ray_cost(scene, *accel, kMapSize, kMapSize))});
+                } catch (const std::runtime_error&) {
+                }
             }
             const std::vector<int> widths = packet_widths(plan, *accel, skipped);
             for (std::size_t s = 0; s < sets.size(); ++s) {
