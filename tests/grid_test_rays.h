@@ -77,22 +77,9 @@ inline std::vector<Rayf> grid_adversarial_rays(const GridGeometry& g, const Scen
     // 2. Inside a cell plane (that direction component +-0), from inside the grid.
     append_in_plane_rays(rays, rng, box, plane, 600);
     // 3. Axis-parallel from random origins in and around the grid; half with a finite tfar.
-    for (int i = 0; i < 600; ++i) {
-        Rayf r;
-        r.org = random_point(rng, grown(box, 0.1f));
-        r.dir = axis_direction(rng, i % 3, (i / 3) % 2 ? 1.0f : -1.0f);
-        if (i % 2) r.tfar = u(rng) * diag;
-        rays.push_back(r);
-    }
+    append_axis_parallel_rays(rays, rng, box, 600);
     // 4. Starting inside cells, some from tnear > 0 (the walk begins mid-grid).
-    for (int i = 0; i < 600; ++i) {
-        Rayf r;
-        r.org = random_point(rng, box);
-        r.dir = random_direction(rng);
-        if (i % 2) r.tnear = u(rng) * 0.5f * diag;
-        if (i % 3 == 0) r.tfar = r.tnear + u(rng) * 0.5f * diag;
-        rays.push_back(r);
-    }
+    append_inside_rays(rays, rng, box, 600);
     // 5. Through cell corners, and from cell corners.
     append_corner_rays(rays, rng, box, corner, 900);
     // 6. Along cell diagonals: ties between all three axes at every step.

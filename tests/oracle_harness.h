@@ -207,6 +207,36 @@ void append_in_plane_rays(std::vector<Rayf>& rays, std::mt19937& rng, const Box3
     }
 }
 
+/// Appends n axis-parallel rays (axis i % 3, both ways) from random points of
+/// `box` grown by a tenth, every other one ending at a finite tfar.
+inline void append_axis_parallel_rays(std::vector<Rayf>& rays, std::mt19937& rng, const Box3f& box, int n) {
+    const float diag = length(box.extent());
+    std::uniform_real_distribution<float> u(0, 1);
+    for (int i = 0; i < n; ++i) {
+        Rayf r;
+        r.org = random_point(rng, grown(box, 0.1f));
+        r.dir = axis_direction(rng, i % 3, (i / 3) % 2 ? 1.0f : -1.0f);
+        if (i % 2) r.tfar = u(rng) * diag;
+        rays.push_back(r);
+    }
+}
+
+/// Appends n rays from random points of `box` in random directions, every
+/// other one from tnear > 0 (the walk begins midway), every third ending at
+/// a finite tfar.
+inline void append_inside_rays(std::vector<Rayf>& rays, std::mt19937& rng, const Box3f& box, int n) {
+    const float diag = length(box.extent());
+    std::uniform_real_distribution<float> u(0, 1);
+    for (int i = 0; i < n; ++i) {
+        Rayf r;
+        r.org = random_point(rng, box);
+        r.dir = random_direction(rng);
+        if (i % 2) r.tnear = u(rng) * 0.5f * diag;
+        if (i % 3 == 0) r.tfar = r.tnear + u(rng) * 0.5f * diag;
+        rays.push_back(r);
+    }
+}
+
 /// Appends n rays from corner()s in random directions (every third) and
 /// through them from random points of `box` grown by half.
 template <class Corner>

@@ -180,22 +180,9 @@ std::vector<Rayf> adversarial_rays(const raypack::KdTree& tree, const Scene& sce
         }
     }
     // 5. Axis-parallel from random origins in and around the tree; half with a finite tfar.
-    for (int i = 0; i < 400; ++i) {
-        Rayf r;
-        r.org = random_point(rng, grown(box, 0.1f));
-        r.dir = axis_dir(i % 3, (i / 3) % 2 ? 1.0f : -1.0f);
-        if (i % 2) r.tfar = u(rng) * diag;
-        rays.push_back(r);
-    }
+    append_axis_parallel_rays(rays, rng, box, 400);
     // 6. Starting inside the tree, some from tnear > 0 (the walk begins mid-tree).
-    for (int i = 0; i < 400; ++i) {
-        Rayf r;
-        r.org = random_point(rng, box);
-        r.dir = random_direction(rng);
-        if (i % 2) r.tnear = u(rng) * 0.5f * diag;
-        if (i % 3 == 0) r.tfar = r.tnear + u(rng) * 0.5f * diag;
-        rays.push_back(r);
-    }
+    append_inside_rays(rays, rng, box, 400);
     // 7. From far away (10 diagonals), aimed into the tree.
     for (int i = 0; i < 200; ++i) {
         Rayf r;

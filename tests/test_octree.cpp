@@ -134,22 +134,9 @@ std::vector<Rayf> octree_adversarial_rays(const Octree& tree, const Scene& scene
     // 2. Inside a node plane (that direction component +-0), from inside the cube.
     append_in_plane_rays(rays, rng, box, plane, 600);
     // 3. Axis-parallel from random origins in and around the cube; half with a finite tfar.
-    for (int i = 0; i < 600; ++i) {
-        Rayf r;
-        r.org = random_point(rng, grown(box, 0.1f));
-        r.dir = axis_direction(rng, i % 3, (i / 3) % 2 ? 1.0f : -1.0f);
-        if (i % 2) r.tfar = u(rng) * diag;
-        rays.push_back(r);
-    }
+    append_axis_parallel_rays(rays, rng, box, 600);
     // 4. Starting inside the octree (in leaves), some from tnear > 0.
-    for (int i = 0; i < 600; ++i) {
-        Rayf r;
-        r.org = random_point(rng, box);
-        r.dir = random_direction(rng);
-        if (i % 2) r.tnear = u(rng) * 0.5f * diag;
-        if (i % 3 == 0) r.tfar = r.tnear + u(rng) * 0.5f * diag;
-        rays.push_back(r);
-    }
+    append_inside_rays(rays, rng, box, 600);
     // 5. Starting exactly on node boundaries (faces, edges, corners).
     for (int i = 0; i < 600; ++i) {
         Rayf r;
