@@ -64,6 +64,10 @@ inline AccelConfig accel_config(std::string kind, KernelChoice kernels = {}) {
     return config;
 }
 
+class Accel;
+struct AccelConfig;
+std::unique_ptr<Accel> build_accel(const Scene& scene, const AccelConfig& config);
+
 class Accel {
 public:
     virtual ~Accel() = default;
@@ -71,7 +75,9 @@ public:
     virtual void intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const = 0;
     /// Any hit in [tnear, tfar]: occluded[i] = 1 if so.
     virtual void occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const = 0;
-    virtual const AccelStats& stats() const = 0;
+    /// What the structure is; build_ms is build_accel's measure of its
+    /// construction (0 for a structure constructed directly).
+    virtual const AccelStats& stats() const { return stats_; }
 
     /// Packet widths this structure traverses natively (1 is always there).
     virtual bool supports_packet(int width) const { return width == 1; }
@@ -122,6 +128,12 @@ public:
         occluded({&ray, 1}, {&o, 1});
         return o != 0;
     }
+
+protected:
+    AccelStats stats_;  ///< filled by each structure's constructor
+
+private:
+    friend std::unique_ptr<Accel> build_accel(const Scene& scene, const AccelConfig& config);
 };
 
 /// Names accepted by AccelConfig::kind.

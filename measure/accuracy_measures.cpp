@@ -114,11 +114,9 @@ public:
         intersect(rays, hits);
         for (std::size_t i = 0; i < rays.size(); ++i) occluded[i] = hits[i].found() ? 1 : 0;
     }
-    const AccelStats& stats() const override { return stats_; }
 
 private:
     BruteForce brute_;
-    AccelStats stats_;
 };
 
 }  // namespace

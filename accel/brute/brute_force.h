@@ -10,7 +10,6 @@ public:
     BruteForce(const Scene& scene, KernelChoice kernels);
     void intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const override;
     void occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override;
-    const AccelStats& stats() const override { return stats_; }
     /// No nodes; prims = every primitive for a closest hit, up to the first hit for any hit.
     bool count_traversal(std::span<const Rayf> rays, bool any_hit, std::span<Hitf> hits,
                          TraversalCounts& counts) const override;
@@ -21,7 +20,6 @@ public:
 private:
     const Scene* scene_;
     KernelChoice kernels_;
-    AccelStats stats_;
 };
 
 }  // namespace raypack

@@ -1,6 +1,5 @@
 #include "accel/bvh/bvh2_accel.h"
 
-#include <chrono>
 #include <stdexcept>
 #include <vector>
 
@@ -14,12 +13,9 @@
 namespace raypack {
 
 Bvh2Accel::Bvh2Accel(const Scene& scene, const AccelConfig& config) : scene_(&scene), kernels_(config.kernels) {
-    const auto start = std::chrono::steady_clock::now();
     bvh_ = build_scene_bvh2(scene, config);
-    const auto stop = std::chrono::steady_clock::now();
     stats_.name = "bvh2";
     stats_.builder = config.builder;
-    stats_.build_ms = std::chrono::duration<double, std::milli>(stop - start).count();
     stats_.nodes = bvh_.nodes.size();
     stats_.leaves = bvh_.leaves;
     stats_.depth = bvh_.depth;

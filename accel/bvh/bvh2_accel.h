@@ -10,7 +10,6 @@ public:
     Bvh2Accel(const Scene& scene, const AccelConfig& config);
     void intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const override;
     void occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override;
-    const AccelStats& stats() const override { return stats_; }
     bool supports_packet(int width) const override;
     void intersect_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const override;
     void occluded_packets(int width, std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override;
@@ -28,7 +27,6 @@ private:
     const Scene* scene_;
     KernelChoice kernels_;
     Bvh2 bvh_;
-    AccelStats stats_;
 };
 
 }  // namespace raypack

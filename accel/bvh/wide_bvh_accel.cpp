@@ -1,7 +1,6 @@
 #include "accel/bvh/wide_bvh_accel.h"
 
 #include <algorithm>
-#include <chrono>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -33,16 +32,13 @@ WideBvhAccel<N, M, Test>::WideBvhAccel(const Scene& scene, const AccelConfig& co
 template <int N, int M, NodeTest Test>
 WideBvhAccel<N, M, Test>::WideBvhAccel(const Scene& scene, const AccelConfig& config, const CollapseConfig& collapse)
     : scene_(&scene), kernels_(config.kernels) {
-    const auto start = std::chrono::steady_clock::now();
     const Bvh2 binary = build_scene_bvh2(scene, config);
     CollapseConfig cc = collapse;
     cc.triangle_layout = collapse_config(config).triangle_layout;  // must match the kernel that runs
     cc.objects = config.kernels.objects;
     bvh_ = collapse_bvh<N, M>(binary, scene, cc);
-    const auto stop = std::chrono::steady_clock::now();
     stats_.name = N == 4 ? "bvh4" : "bvh8";
     stats_.builder = config.builder;
-    stats_.build_ms = std::chrono::duration<double, std::milli>(stop - start).count();
     stats_.nodes = bvh_.nodes.size();
     stats_.leaves = bvh_.leaves;
     stats_.depth = bvh_.depth;

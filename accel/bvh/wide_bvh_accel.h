@@ -18,7 +18,6 @@ public:
     WideBvhAccel(const Scene& scene, const AccelConfig& config, const CollapseConfig& collapse);
     void intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const override;
     void occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override;
-    const AccelStats& stats() const override { return stats_; }
     bool count_traversal(std::span<const Rayf> rays, bool any_hit, std::span<Hitf> hits, TraversalCounts& counts) const override;  // wide_counting.cpp
     const WideBvh<N, M>& bvh() const { return bvh_; }
 
@@ -48,7 +47,6 @@ private:
     WidePacketConfig packet_config_[3] = {{default_wide_switch_below(N, 4)}, {default_wide_switch_below(N, 8)},
                                           {default_wide_switch_below(N, 16)}};  ///< K = 4, 8, 16
     WideBvh<N, M> bvh_;
-    AccelStats stats_;
 };
 
 /// The configurations `--accel bvh4` and `--accel bvh8` run: leaf blocks of

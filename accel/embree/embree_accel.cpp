@@ -251,7 +251,8 @@ EmbreeAccel::EmbreeAccel(const Scene& scene, EmbreeOptions options) {
     rtcSetDeviceErrorFunction(device_, &EmbreeAccel::on_error, this);
     rtcSetDeviceMemoryMonitorFunction(device_, &EmbreeAccel::memory_monitor, this);
     // Timed from the scene on, like our builders: an application creates
-    // the device once, and pays the scene set-up and commit per scene.
+    // the device once, and pays the scene set-up and commit per scene
+    // (build_accel keeps this time instead of its own).
     options_ = options;
     const auto start = std::chrono::steady_clock::now();
     try {

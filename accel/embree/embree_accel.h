@@ -54,7 +54,6 @@ public:
 
     void intersect(std::span<const Rayf> rays, std::span<Hitf> hits) const override;
     void occluded(std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override;
-    const AccelStats& stats() const override { return stats_; }
 
     /// Packets of 4, 8 and 16 go through rtcIntersect4/8/16 and
     /// rtcOccluded4/8/16; width 1 through rtcIntersect1 / rtcOccluded1.
@@ -91,7 +90,6 @@ private:
     std::atomic<std::int64_t> allocated_{0};
     mutable std::mutex error_mutex_;
     std::string first_error_;  ///< Embree's own message, reported by fail()
-    AccelStats stats_;
     bool native_[3] = {false, false, false};  ///< RAY4, RAY8, RAY16
 };
 

@@ -3,7 +3,6 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <chrono>
 #include <vector>
 
 #include "accel/cell_accel_impl.h"
@@ -19,12 +18,10 @@ namespace raypack {
 
 Grid2Accel::Grid2Accel(const Scene& scene, const AccelConfig& config, const TwoLevelGridConfig& grid_config)
     : scene_(&scene), kernels_(config.kernels) {
-    const auto start = std::chrono::steady_clock::now();
     const std::size_t n = scene.primitive_count();
     std::vector<Box3f> boxes(n);
     tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) { boxes[i] = primitive_bounds(scene, std::uint32_t(i)); });
     grid_ = build_two_level_grid(boxes, PrimitiveBoxOverlap{&scene}, grid_config);
-    const auto stop = std::chrono::steady_clock::now();
     packets_exact_ = grid_packets_exact(grid_.top) &&
                      std::all_of(grid_.cells.begin(), grid_.cells.end(), [](const Grid& g) { return grid_packets_exact(g); });
     std::size_t references = 0, empty = 0, cells = 0;
@@ -36,7 +33,6 @@ Grid2Accel::Grid2Accel(const Scene& scene, const AccelConfig& config, const TwoL
     const std::size_t top_empty = grid_.top.geometry.cells() - grid_.cells.size();
     stats_.name = "grid2";
     stats_.builder = "two-level";
-    stats_.build_ms = std::chrono::duration<double, std::milli>(stop - start).count();
     stats_.nodes = grid_.top.geometry.cells() + cells;
     stats_.leaves = cells - empty;
     stats_.empty_leaves = empty + top_empty;

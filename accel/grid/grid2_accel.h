@@ -16,7 +16,6 @@ namespace raypack {
 class Grid2Accel final : public CellAccel<Grid2Accel, GridRayCounters> {
 public:
     Grid2Accel(const Scene& scene, const AccelConfig& config, const TwoLevelGridConfig& grid_config = {});
-    const AccelStats& stats() const override { return stats_; }
     const TwoLevelGrid& grid() const { return grid_; }
 
 private:
@@ -35,7 +34,6 @@ private:
     KernelChoice kernels_;
     TwoLevelGrid grid_;
     bool packets_exact_ = true;  ///< every grid's counters are exact in floats (grid_packet.h)
-    AccelStats stats_;
 };
 
 extern template class CellAccel<Grid2Accel, GridRayCounters>;  // grid2_accel.cpp

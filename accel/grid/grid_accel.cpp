@@ -3,7 +3,6 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <chrono>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -21,17 +20,14 @@ GridAccel::GridAccel(const Scene& scene, const AccelConfig& config, const GridCo
       kernels_(config.kernels),
       mailbox_(grid_config.mailbox),
       coherent_packets_(grid_config.coherent_packets) {
-    const auto start = std::chrono::steady_clock::now();
     const std::size_t n = scene.primitive_count();
     std::vector<Box3f> boxes(n);
     tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) { boxes[i] = primitive_bounds(scene, std::uint32_t(i)); });
     const PrimitiveBoxOverlap exact{&scene};
     grid_ = build_grid(boxes, grid_config.exact_overlap ? &exact : nullptr, grid_config);
-    const auto stop = std::chrono::steady_clock::now();
     for (std::size_t c = 0; c < grid_.geometry.cells(); ++c) empty_cells_ += grid_.cell_begin[c] == grid_.cell_begin[c + 1];
     stats_.name = "grid";
     stats_.builder = "uniform";
-    stats_.build_ms = std::chrono::duration<double, std::milli>(stop - start).count();
     stats_.nodes = grid_.geometry.cells();
     stats_.leaves = grid_.geometry.cells() - empty_cells_;
     stats_.bytes = grid_.bytes();

@@ -32,7 +32,6 @@ struct GridRayCounters {
 class GridAccel final : public CellAccel<GridAccel, GridRayCounters> {
 public:
     GridAccel(const Scene& scene, const AccelConfig& config, const GridConfig& grid_config = {});
-    const AccelStats& stats() const override { return stats_; }
 
     const Grid& grid() const { return grid_; }
     std::array<int, 3> resolution() const { return grid_.geometry.res; }
@@ -67,7 +66,6 @@ private:
     std::size_t empty_cells_ = 0;
     bool mailbox_ = true;
     bool coherent_packets_ = true;
-    AccelStats stats_;
 };
 
 extern template class CellAccel<GridAccel, GridRayCounters>;  // grid_accel.cpp

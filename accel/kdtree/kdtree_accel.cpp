@@ -2,7 +2,6 @@
 
 #include <tbb/parallel_for.h>
 
-#include <chrono>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -18,7 +17,6 @@ namespace raypack {
 
 KdTreeAccel::KdTreeAccel(const Scene& scene, const AccelConfig& config, const KdTreeConfig& kd_config)
     : scene_(&scene), kernels_(config.kernels) {
-    const auto start = std::chrono::steady_clock::now();
     const std::size_t n = scene.primitive_count();
     std::vector<Box3f> boxes(n);
     tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) { boxes[i] = primitive_bounds(scene, std::uint32_t(i)); });
@@ -27,10 +25,8 @@ KdTreeAccel::KdTreeAccel(const Scene& scene, const AccelConfig& config, const Kd
         return clipper.clip(prim, voxel, out);
     };
     tree_ = build_kdtree(boxes, clip, kd_config);
-    const auto stop = std::chrono::steady_clock::now();
     stats_.name = "kdtree";
     stats_.builder = "sah-nlogn";
-    stats_.build_ms = std::chrono::duration<double, std::milli>(stop - start).count();
     stats_.nodes = tree_.nodes.size();
     stats_.leaves = tree_.leaves;
     stats_.bytes = tree_.bytes();

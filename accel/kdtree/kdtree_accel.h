@@ -27,7 +27,6 @@ struct KdRayCounters {
 class KdTreeAccel final : public CellAccel<KdTreeAccel, KdRayCounters> {
 public:
     KdTreeAccel(const Scene& scene, const AccelConfig& config, const KdTreeConfig& kd_config = {});
-    const AccelStats& stats() const override { return stats_; }
 
     const KdTree& tree() const { return tree_; }
     /// References per primitive: how often the average primitive is stored.
@@ -46,7 +45,6 @@ private:
     const Scene* scene_;
     KernelChoice kernels_;
     KdTree tree_;
-    AccelStats stats_;
 };
 
 extern template class CellAccel<KdTreeAccel, KdRayCounters>;  // kdtree_accel.cpp

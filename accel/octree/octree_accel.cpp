@@ -2,7 +2,6 @@
 
 #include <tbb/parallel_for.h>
 
-#include <chrono>
 #include <cmath>
 #include <vector>
 
@@ -16,13 +15,11 @@ namespace raypack {
 
 OctreeAccel::OctreeAccel(const Scene& scene, const AccelConfig& config, const OctreeConfig& octree_config)
     : scene_(&scene), kernels_(config.kernels) {
-    const auto start = std::chrono::steady_clock::now();
     const std::size_t n = scene.primitive_count();
     std::vector<Box3f> boxes(n);
     tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) { boxes[i] = primitive_bounds(scene, std::uint32_t(i)); });
     const PrimitiveBoxOverlap exact{&scene};
     tree_ = build_octree(boxes, octree_config.exact_overlap ? &exact : nullptr, octree_config);
-    const auto stop = std::chrono::steady_clock::now();
     std::size_t leaves = 0;
     for (const OctreeNode& node : tree_.nodes) {
         leaves += node.is_leaf();
@@ -30,7 +27,6 @@ OctreeAccel::OctreeAccel(const Scene& scene, const AccelConfig& config, const Oc
     }
     stats_.name = "octree";
     stats_.builder = "adaptive";
-    stats_.build_ms = std::chrono::duration<double, std::milli>(stop - start).count();
     stats_.nodes = tree_.nodes.size();
     stats_.leaves = leaves;
     stats_.bytes = tree_.bytes();

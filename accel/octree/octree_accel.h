@@ -26,7 +26,6 @@ struct OctreeRayCounters {
 class OctreeAccel final : public CellAccel<OctreeAccel, OctreeRayCounters> {
 public:
     OctreeAccel(const Scene& scene, const AccelConfig& config, const OctreeConfig& octree_config = {});
-    const AccelStats& stats() const override { return stats_; }
 
     const Octree& octree() const { return tree_; }
     std::size_t reference_count() const { return tree_.refs.size(); }
@@ -47,7 +46,6 @@ private:
     KernelChoice kernels_;
     Octree tree_;
     std::size_t empty_leaves_ = 0;
-    AccelStats stats_;
 };
 
 extern template class CellAccel<OctreeAccel, OctreeRayCounters>;  // octree_accel.cpp
