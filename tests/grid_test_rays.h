@@ -59,15 +59,10 @@ inline void expect_agreement(const Scene& scene, const Accel& grid, const std::v
 
 // ---- Ray sets -----------------------------------------------------------------------
 
-/// random_rays() (tests/oracle_harness.h) draws origins in the scene box
-/// grown by this fraction per side, so that some start outside the structure.
-inline constexpr float kOriginGrowth = 0.2f;
-
 /// Rays that make a 3D-DDA stumble, built from the grid's own planes.
 inline std::vector<Rayf> grid_adversarial_rays(const GridGeometry& g, const Scene& scene, std::mt19937& rng) {
     std::vector<Rayf> rays;
     const Box3f box = g.bounds;
-    const float diag = length(box.extent());
     std::uniform_real_distribution<float> u(0, 1);
     auto plane = [&](int axis) { return g.plane(axis, int(rng() % std::uint32_t(g.res[axis] + 1))); };
     auto corner = [&] { return Vec3f{plane(0), plane(1), plane(2)}; };
@@ -93,13 +88,7 @@ inline std::vector<Rayf> grid_adversarial_rays(const GridGeometry& g, const Scen
         rays.push_back(r);
     }
     // 7. From far away (10 grid diagonals), aimed into the grid.
-    for (int i = 0; i < 300; ++i) {
-        Rayf r;
-        const Vec3f target = random_point(rng, box);
-        r.org = target - random_direction(rng) * (10.0f * diag);
-        r.dir = target - r.org;
-        rays.push_back(r);
-    }
+    append_far_rays(rays, rng, box, 300);
     // 8. On the grid's faces, the far ones included: inwards and along the face.
     append_face_rays(rays, rng, box, 300);
     // 9. Aimed at triangle vertices and sphere poles, which lie on cell planes only by chance.

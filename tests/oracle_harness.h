@@ -7,6 +7,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <filesystem>
 #include <cstdint>
@@ -18,6 +19,7 @@
 #include <vector>
 
 #include "accel/accel.h"
+#include "accel/brute/brute_force.h"
 #include "accel/primitive_intersector.h"
 #include "kernels/aabb.h"
 #include "render/camera_rays.h"
@@ -124,6 +126,58 @@ inline std::string occlusion_mismatches(const std::vector<Rayf>& rays, const std
     }
     return first;
 }
+
+/// How a structure's packets must answer against its own single rays.
+enum class PacketAnswers {
+    UpToTies,  ///< as hit_mismatches: another primitive only at the same t (a shared edge)
+    BitForBit  ///< the same primitive, t, u and v to the bit
+};
+
+/// Closest hit and occlusion of every ray against brute force (exact, ties
+/// at shared edges aside), then packets of every compiled width against the
+/// structure's own single rays.
+inline void expect_oracle_agreement(const Scene& scene, const Accel& accel, const std::vector<Rayf>& rays,
+                                    const std::string& what, PacketAnswers packets = PacketAnswers::UpToTies) {
+    const BruteForce brute(scene, KernelChoice{});
+    const std::vector<Hitf> truth = trace_hits(brute, rays);
+    const std::vector<Hitf> single = trace_hits(accel, rays);
+    std::size_t n = 0;
+    std::string s = hit_mismatches(rays, truth, single, n, "brute", "single");
+    EXPECT_EQ(n, 0u) << what << ": " << n << " of " << rays.size() << " closest hits differ" << s;
+    // Brute force finds a closest hit iff some primitive is hit within the
+    // ray's [tnear, tfar], which is its occlusion answer.
+    std::vector<std::uint8_t> occluded(rays.size());
+    for (std::size_t i = 0; i < rays.size(); ++i) occluded[i] = truth[i].found() ? 1 : 0;
+    s = occlusion_mismatches(rays, occluded, trace_occlusion(accel, rays), n);
+    EXPECT_EQ(n, 0u) << what << ": " << n << " of " << rays.size() << " occlusion answers differ" << s;
+    for (int width : {4, 8, 16}) {
+        if (!accel.supports_packet(width)) continue;
+        const std::vector<Hitf> got = trace_hits(accel, rays, width);
+        if (packets == PacketAnswers::UpToTies) {
+            s = hit_mismatches(rays, single, got, n, "single", "packet");
+        } else {
+            s.clear(), n = 0;
+            auto bits = [](float x) { return std::bit_cast<std::uint32_t>(x); };
+            for (std::size_t i = 0; i < rays.size(); ++i) {
+                const Hitf &w = single[i], &g = got[i];
+                const bool same = g.prim == w.prim && bits(g.t) == bits(w.t) &&
+                                  (!w.found() || (bits(g.u) == bits(w.u) && bits(g.v) == bits(w.v)));
+                if (!same && ++n <= 3)
+                    s += "\n  ray " + std::to_string(i) + ": " + describe(rays[i]) + "\n    single " + describe(w) +
+                         ", packet " + describe(g);
+            }
+        }
+        EXPECT_EQ(n, 0u) << what << " width " << width << ": " << n << " of " << rays.size()
+                         << " packet hits differ from single rays" << s;
+        s = occlusion_mismatches(rays, occluded, trace_occlusion(accel, rays, width), n);
+        EXPECT_EQ(n, 0u) << what << " width " << width << ": " << n << " of " << rays.size()
+                         << " packet occlusion answers differ" << s;
+    }
+}
+
+/// random_rays() draws origins in the scene box grown by this fraction per
+/// side, so that some start outside the structure.
+inline constexpr float kOriginGrowth = 0.2f;
 
 /// Every scenes/*.nff plus the bunny, found on disk so that new scenes join in.
 inline std::vector<std::string> shared_scene_files() {
@@ -268,6 +322,18 @@ inline void append_face_rays(std::vector<Rayf>& rays, std::mt19937& rng, const B
         r.org[a] = hi ? box.hi[a] : box.lo[a];
         r.dir = random_direction(rng);
         r.dir[a] = i % 4 == 0 ? signed_zero(rng) : (hi ? -1.0f : 1.0f) * std::fabs(r.dir[a]);
+        rays.push_back(r);
+    }
+}
+
+/// n rays from far away (10 diagonals of `box`), each aimed at a random point of it.
+inline void append_far_rays(std::vector<Rayf>& rays, std::mt19937& rng, const Box3f& box, int n) {
+    const float diag = length(box.extent());
+    for (int i = 0; i < n; ++i) {
+        Rayf r;
+        const Vec3f target = random_point(rng, box);
+        r.org = target - random_direction(rng) * (10.0f * diag);
+        r.dir = target - r.org;
         rays.push_back(r);
     }
 }

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "tests/oracle_harness.h"
+#include "tests/cell_test_cases.h"
 #include "tests/grid_test_rays.h"
 #include "accel/accel.h"
 #include "accel/brute/brute_force.h"
@@ -41,6 +42,7 @@ namespace raypack::grid_test {
 
 using namespace raypack::oracle_harness;
 using namespace raypack::grid_test_rays;
+using namespace raypack::cell_test_cases;
 namespace {
 
 std::unique_ptr<GridAccel> make_grid(const Scene& scene, const GridConfig& gc = {}) {
@@ -96,74 +98,17 @@ INSTANTIATE_TEST_SUITE_P(, Grid, ::testing::ValuesIn(shared_scene_files()), para
 
 // ---- Hand-made scenes -----------------------------------------------------------------
 
-Scene scene_with(const std::function<void(Scene&)>& add) {
-    Scene s;
-    s.materials.push_back({});
-    add(s);
-    s.update_features();
-    return s;
-}
-
-TEST_F(Grid, RegisteredAsAnAccelKind) {
-    const auto kinds = accel_kinds();
-    EXPECT_NE(std::find_if(kinds.begin(), kinds.end(), [](const char* k) { return std::string(k) == "grid"; }),
-              kinds.end());
-    EXPECT_NE(accel_kinds_list().find("grid"), std::string::npos);
-}
-
-TEST_F(Grid, OnePrimitiveOfEachKind) {
-    const std::vector<Scene> scenes = {
-        scene_with([](Scene& s) { s.add_sphere({1, 2, 3}, 0.5f, 0); }),
-        scene_with([](Scene& s) { s.add_triangle({0, 0, 0}, {1, 0, 0}, {0, 1, 1}, 0); }),
-        scene_with([](Scene& s) { s.add_cone({0, 0, 0}, 0.5f, {0, 0, 2}, 0.1f, 0); }),
-    };
-    std::mt19937 rng(7);
-    for (const Scene& scene : scenes) {
+// Rays against brute force on these scenes: tests/test_cell_structures.cpp.
+TEST_F(Grid, OnePrimitiveGivesAtLeastOneCell) {
+    for (const Scene& scene : one_primitive_scenes()) {
         const auto grid = make_grid(scene);
         EXPECT_GE(grid->cell_count(), 1u);
         for (int r : grid->resolution()) EXPECT_GE(r, 1);
-        std::vector<Rayf> rays = random_rays(scene, rng, 500, kOriginGrowth);
-        const std::vector<Rayf> adv = grid_adversarial_rays(grid->grid().geometry, scene, rng);
-        rays.insert(rays.end(), adv.begin(), adv.end());
-        expect_agreement(scene, *grid, rays, "one " + std::to_string(int(scene.prims[0].kind)));
     }
+    EXPECT_EQ(make_grid(Scene{})->cell_count(), 0u);
 }
 
-TEST_F(Grid, EmptySceneMissesEverything) {
-    const Scene scene;
-    const auto grid = make_grid(scene);
-    Rayf r;
-    r.dir = {1, 1, 1};
-    EXPECT_FALSE(grid->intersect1(r).found());
-    EXPECT_FALSE(grid->occluded1(r));
-    EXPECT_EQ(grid->cell_count(), 0u);
-}
-
-/// A triangulated square of n x n quads in the plane `axis` = 0.5, plus
-/// random triangles in the same plane.
-Scene flat_scene(int axis, int n, std::mt19937& rng) {
-    return scene_with([&](Scene& s) {
-        auto point = [&](float u, float v) {
-            Vec3f p;
-            p[axis] = 0.5f;
-            p[(axis + 1) % 3] = u;
-            p[(axis + 2) % 3] = v;
-            return p;
-        };
-        const float h = 1.0f / float(n);
-        for (int i = 0; i < n; ++i) {
-            for (int j = 0; j < n; ++j) {
-                const float u = float(i) * h, v = float(j) * h;
-                s.add_triangle(point(u, v), point(u + h, v), point(u + h, v + h), 0);
-                s.add_triangle(point(u, v), point(u + h, v + h), point(u, v + h), 0);
-            }
-        }
-        std::uniform_real_distribution<float> u(0, 1);
-        for (int i = 0; i < 100; ++i) s.add_triangle(point(u(rng), u(rng)), point(u(rng), u(rng)), point(u(rng), u(rng)), 0);
-    });
-}
-
-TEST_F(Grid, FlatScenes) {
+TEST_F(Grid, FlatScenesGetOneLayerOfCells) {
     std::mt19937 rng(11);
     for (int axis = 0; axis < 3; ++axis) {
         SCOPED_TRACE(axis);
@@ -176,51 +121,16 @@ TEST_F(Grid, FlatScenes) {
         const double per_prim = double(grid->cell_count()) / double(scene.primitive_count());
         EXPECT_GT(per_prim, 0.5 * GridConfig{}.lambda);
         EXPECT_LT(per_prim, 2.0 * GridConfig{}.lambda);
-
-        std::vector<Rayf> rays = random_rays(scene, rng, 1000, kOriginGrowth);
-        const std::vector<Rayf> adv = grid_adversarial_rays(g, scene, rng);
-        rays.insert(rays.end(), adv.begin(), adv.end());
-        std::uniform_real_distribution<float> u(0, 1);
-        for (int i = 0; i < 1000; ++i) {
-            Rayf r;
-            r.org[axis] = 0.5f;
-            r.org[(axis + 1) % 3] = u(rng) * 1.4f - 0.2f;
-            r.org[(axis + 2) % 3] = u(rng) * 1.4f - 0.2f;
-            r.dir = random_direction(rng);
-            if (i % 2) {
-                r.dir[axis] = signed_zero(rng);  // in the plane
-            } else {
-                r.org -= r.dir * (0.5f + u(rng));  // across the plane, starting off it
-            }
-            rays.push_back(r);
-        }
-        expect_agreement(scene, *grid, rays, "flat " + std::to_string(axis));
     }
 }
 
-TEST_F(Grid, PrimitivesSpanningManyCells) {
+TEST_F(Grid, BigPrimitivesAreInManyCells) {
     std::mt19937 rng(13);
-    std::uniform_real_distribution<float> u(0, 1);
-    const Scene scene = scene_with([&](Scene& s) {
-        for (int i = 0; i < 2000; ++i) {
-            const Vec3f p{u(rng) * 10, u(rng) * 10, u(rng) * 10};
-            s.add_triangle(p, p + Vec3f{0.2f, 0, 0}, p + Vec3f{0, 0.2f, 0.1f}, 0);
-        }
-        // Huge triangles across the whole box, a big sphere and a long thin cone.
-        s.add_triangle({-1, -1, 5}, {11, -1, 5.5f}, {5, 11, 4}, 0);
-        s.add_triangle({0, 0, 0}, {10, 10, 10}, {10, 0, 10}, 0);
-        s.add_sphere({5, 5, 5}, 3, 0);
-        s.add_cone({0, 10, 0}, 0.3f, {10, 0, 10}, 0.3f, 0);
-    });
+    const Scene scene = spanning_scene(rng);
     const auto grid = make_grid(scene);
-    // The big primitives are each in many cells.
     std::vector<std::size_t> cells_of(scene.primitive_count(), 0);
     for (std::uint32_t p : grid->grid().refs) ++cells_of[p];
     for (std::uint32_t p = 2000; p < 2004; ++p) EXPECT_GT(cells_of[p], 50u) << p;
-    std::vector<Rayf> rays = random_rays(scene, rng, 3000, kOriginGrowth);
-    const std::vector<Rayf> adv = grid_adversarial_rays(grid->grid().geometry, scene, rng);
-    rays.insert(rays.end(), adv.begin(), adv.end());
-    expect_agreement(scene, *grid, rays, "spanning");
 }
 
 TEST_F(Grid, ReferenceCapCoarsensTheGrid) {

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "tests/oracle_harness.h"
+#include "tests/cell_test_cases.h"
 #include "accel/accel.h"
 #include "accel/brute/brute_force.h"
 #include "accel/grid/triangle_box_overlap.h"
@@ -34,6 +35,7 @@
 namespace raypack::octree_test {
 
 using namespace raypack::oracle_harness;
+using namespace raypack::cell_test_cases;
 namespace {
 
 // ---- Tracing and comparing --------------------------------------------------------
@@ -72,33 +74,13 @@ std::vector<int> packet_widths() {
     return w;
 }
 
-/// Closest hit and occlusion of every ray against brute force, single rays
-/// and packets of every width.
+/// Closest hit and occlusion of every ray against brute force, then packets
+/// of every width against single rays (ties at shared edges aside).
 void expect_agreement(const Scene& scene, const Accel& octree, const std::vector<Rayf>& rays, const std::string& what) {
-    const BruteForce brute(scene, KernelChoice{});
-    const std::vector<Hitf> truth = trace(brute, rays);
-    std::vector<std::uint8_t> occluded(rays.size());
-    for (std::size_t i = 0; i < rays.size(); ++i) occluded[i] = truth[i].found() ? 1 : 0;
-    const std::vector<Hitf> single = trace(octree, rays);
-    std::size_t n = 0;
-    std::string s = hit_mismatches(rays, truth, single, n, "brute", "octree");
-    EXPECT_EQ(n, 0u) << what << ": " << n << " of " << rays.size() << " closest hits differ" << s;
-    s = occlusion_mismatches(rays, occluded, trace_occluded(octree, rays), n);
-    EXPECT_EQ(n, 0u) << what << ": " << n << " of " << rays.size() << " occlusion answers differ" << s;
-    for (int w : packet_widths()) {
-        s = hit_mismatches(rays, single, trace(octree, rays, w), n, "single", "packet");
-        EXPECT_EQ(n, 0u) << what << " K=" << w << ": " << n << " of " << rays.size() << " packet hits differ" << s;
-        s = occlusion_mismatches(rays, occluded, trace_occluded(octree, rays, w), n);
-        EXPECT_EQ(n, 0u) << what << " K=" << w << ": " << n << " of " << rays.size() << " packet occlusions differ"
-                         << s;
-    }
+    expect_oracle_agreement(scene, octree, rays, what);
 }
 
 // ---- Ray sets -----------------------------------------------------------------------
-
-/// random_rays() (tests/oracle_harness.h) draws origins in the scene box
-/// grown by this fraction per side, so that some start outside the structure.
-constexpr float kOriginGrowth = 0.2f;
 
 /// As camera_rays() (tests/oracle_harness.h), in another order: 4x4 pixel
 /// tiles one after the other.
@@ -111,64 +93,6 @@ std::vector<Rayf> tiled_camera_rays(const Scene& scene, int size) {
             for (int y = ty; y < std::min(size, ty + 4); ++y)
                 for (int x = tx; x < std::min(size, tx + 4); ++x)
                     rays.push_back(camera_ray(f, float(x) + 0.5f, float(y) + 0.5f));
-    return rays;
-}
-
-/// Rays that make an octree traversal stumble, from the tree's own planes:
-/// the cube's midplanes at depths 1 to 6 (node faces at those depths).
-std::vector<Rayf> octree_adversarial_rays(const Octree& tree, const Scene& scene, std::mt19937& rng) {
-    std::vector<Rayf> rays;
-    const Box3f box = tree.cube;
-    const float side = box.hi.x - box.lo.x;
-    const float diag = length(box.extent());
-    std::uniform_real_distribution<float> u(0, 1);
-    // A node plane at a random depth 1..6: lo + side * k / 2^d, as the traversal sees it.
-    auto plane = [&](int axis) {
-        const int d = 1 + int(rng() % 6);
-        const int k = int(rng() % ((1u << d) + 1));
-        return box.lo[axis] + (box.hi[axis] - box.lo[axis]) * (float(k) / float(1 << d));
-    };
-    auto corner = [&] { return Vec3f{plane(0), plane(1), plane(2)}; };
-    // 1. Along node edges: the two other coordinates on node planes, axis-parallel, from outside.
-    append_edge_rays(rays, rng, box, corner, 600);
-    // 2. Inside a node plane (that direction component +-0), from inside the cube.
-    append_in_plane_rays(rays, rng, box, plane, 600);
-    // 3. Axis-parallel from random origins in and around the cube; half with a finite tfar.
-    append_axis_parallel_rays(rays, rng, box, 600);
-    // 4. Starting inside the octree (in leaves), some from tnear > 0.
-    append_inside_rays(rays, rng, box, 600);
-    // 5. Starting exactly on node boundaries (faces, edges, corners).
-    for (int i = 0; i < 600; ++i) {
-        Rayf r;
-        r.org = random_point(rng, box);
-        for (int a = 0; a < 3; ++a)
-            if (a == i % 3 || rng() % 3 == 0) r.org[a] = plane(a);
-        r.dir = random_direction(rng);
-        rays.push_back(r);
-    }
-    // 6. Through node corners, and from node corners.
-    append_corner_rays(rays, rng, box, corner, 900);
-    // 7. Along node diagonals: ties between all three axes at every midplane.
-    for (int i = 0; i < 300; ++i) {
-        Rayf r;
-        const float s = side / float(1 << (1 + rng() % 5));
-        Vec3f d{s, s, s};
-        for (int a = 0; a < 3; ++a)
-            if (rng() % 2) d[a] = -d[a];
-        r.org = corner() - d * float(1 + rng() % 4);
-        r.dir = d;
-        rays.push_back(r);
-    }
-    // 8. From far away (10 cube diagonals), aimed into the cube.
-    for (int i = 0; i < 300; ++i) {
-        Rayf r;
-        const Vec3f target = random_point(rng, box);
-        r.org = target - random_direction(rng) * (10.0f * diag);
-        r.dir = target - r.org;
-        rays.push_back(r);
-    }
-    // 9. Aimed at triangle vertices and sphere poles.
-    append_vertex_rays(rays, scene, rng, grown(box, 0.2f), 300);
     return rays;
 }
 
@@ -268,29 +192,6 @@ INSTANTIATE_TEST_SUITE_P(, Octree, ::testing::ValuesIn(shared_scene_files()), pa
 
 // ---- Hand-made scenes -----------------------------------------------------------------
 
-Scene scene_with(const std::function<void(Scene&)>& add) {
-    Scene s;
-    s.materials.push_back({});
-    add(s);
-    s.update_features();
-    return s;
-}
-
-TEST_F(Octree, RegisteredAsAnAccelKind) {
-    const auto kinds = accel_kinds();
-    EXPECT_NE(std::find_if(kinds.begin(), kinds.end(), [](const char* k) { return std::string(k) == "octree"; }),
-              kinds.end());
-    EXPECT_NE(accel_kinds_list().find("octree"), std::string::npos);
-    const Scene scene = scene_with([](Scene& s) { s.add_sphere({0, 0, 0}, 1, 0); });
-    AccelConfig config;
-    config.kind = "octree";
-    const auto accel = build_accel(scene, config);
-    EXPECT_EQ(accel->stats().name, "octree");
-    for (int w : packet_widths()) EXPECT_TRUE(accel->supports_packet(w));
-    EXPECT_TRUE(accel->supports_packet(1));
-    EXPECT_FALSE(accel->supports_packet(3));
-}
-
 TEST_F(Octree, StateTableIsThePapers) {
     // new_node: from child c, leaving through axis k's plane, moves to c | bit
     // if that bit was clear, else out of the parent (8).
@@ -308,63 +209,13 @@ TEST_F(Octree, StateTableIsThePapers) {
     EXPECT_EQ(revelles::first_node(-1, 1, -1, 0), 5);
 }
 
-TEST_F(Octree, OnePrimitiveOfEachKind) {
-    const std::vector<Scene> scenes = {
-        scene_with([](Scene& s) { s.add_sphere({1, 2, 3}, 0.5f, 0); }),
-        scene_with([](Scene& s) { s.add_triangle({0, 0, 0}, {1, 0, 0}, {0, 1, 1}, 0); }),
-        scene_with([](Scene& s) { s.add_cone({0, 0, 0}, 0.5f, {0, 0, 2}, 0.1f, 0); }),
-    };
-    std::mt19937 rng(7);
-    for (const Scene& scene : scenes) {
-        const auto octree = make_octree(scene);
-        EXPECT_EQ(octree->stats().nodes, 1u);
-        std::vector<Rayf> rays = random_rays(scene, rng, 500, kOriginGrowth);
-        const std::vector<Rayf> adv = octree_adversarial_rays(octree->octree(), scene, rng);
-        rays.insert(rays.end(), adv.begin(), adv.end());
-        expect_agreement(scene, *octree, rays, "one " + std::to_string(int(scene.prims[0].kind)));
-    }
+// Rays against brute force on these scenes: tests/test_cell_structures.cpp.
+TEST_F(Octree, OnePrimitiveIsOneLeaf) {
+    for (const Scene& scene : one_primitive_scenes()) EXPECT_EQ(make_octree(scene)->stats().nodes, 1u);
+    EXPECT_EQ(make_octree(Scene{})->stats().nodes, 0u);
 }
 
-TEST_F(Octree, EmptySceneMissesEverything) {
-    const Scene scene;
-    const auto octree = make_octree(scene);
-    Rayf r;
-    r.dir = {1, 1, 1};
-    EXPECT_FALSE(octree->intersect1(r).found());
-    EXPECT_FALSE(octree->occluded1(r));
-    EXPECT_EQ(octree->stats().nodes, 0u);
-    std::vector<Rayf> rays(20, r);
-    for (int w : packet_widths()) {
-        for (const Hitf& h : trace(*octree, rays, w)) EXPECT_FALSE(h.found());
-        for (std::uint8_t o : trace_occluded(*octree, rays, w)) EXPECT_EQ(o, 0);
-    }
-}
-
-/// A triangulated square of n x n quads in the plane `axis` = 0.5, plus
-/// random triangles in the same plane.
-Scene flat_scene(int axis, int n, std::mt19937& rng) {
-    return scene_with([&](Scene& s) {
-        auto point = [&](float u, float v) {
-            Vec3f p;
-            p[axis] = 0.5f;
-            p[(axis + 1) % 3] = u;
-            p[(axis + 2) % 3] = v;
-            return p;
-        };
-        const float h = 1.0f / float(n);
-        for (int i = 0; i < n; ++i) {
-            for (int j = 0; j < n; ++j) {
-                const float u = float(i) * h, v = float(j) * h;
-                s.add_triangle(point(u, v), point(u + h, v), point(u + h, v + h), 0);
-                s.add_triangle(point(u, v), point(u + h, v + h), point(u, v + h), 0);
-            }
-        }
-        std::uniform_real_distribution<float> u(0, 1);
-        for (int i = 0; i < 100; ++i) s.add_triangle(point(u(rng), u(rng)), point(u(rng), u(rng)), point(u(rng), u(rng)), 0);
-    });
-}
-
-TEST_F(Octree, FlatScenes) {
+TEST_F(Octree, FlatScenesAreSplit) {
     std::mt19937 rng(11);
     for (int axis = 0; axis < 3; ++axis) {
         SCOPED_TRACE(axis);
@@ -374,50 +225,17 @@ TEST_F(Octree, FlatScenes) {
         // The plane lies in the cube's midplane along `axis`: it is split
         // anyway, and both halves hold the whole plane only where it matters.
         EXPECT_GT(octree->stats().depth, 2);
-        std::vector<Rayf> rays = random_rays(scene, rng, 1000, kOriginGrowth);
-        const std::vector<Rayf> adv = octree_adversarial_rays(octree->octree(), scene, rng);
-        rays.insert(rays.end(), adv.begin(), adv.end());
-        std::uniform_real_distribution<float> u(0, 1);
-        for (int i = 0; i < 1000; ++i) {
-            Rayf r;
-            r.org[axis] = 0.5f;
-            r.org[(axis + 1) % 3] = u(rng) * 1.4f - 0.2f;
-            r.org[(axis + 2) % 3] = u(rng) * 1.4f - 0.2f;
-            r.dir = random_direction(rng);
-            if (i % 2) {
-                r.dir[axis] = signed_zero(rng);  // in the plane
-            } else {
-                r.org -= r.dir * (0.5f + u(rng));  // across the plane, starting off it
-            }
-            rays.push_back(r);
-        }
-        expect_agreement(scene, *octree, rays, "flat " + std::to_string(axis));
     }
 }
 
-TEST_F(Octree, PrimitivesSpanningManyNodes) {
+TEST_F(Octree, BigPrimitivesAreInManyLeaves) {
     std::mt19937 rng(13);
-    std::uniform_real_distribution<float> u(0, 1);
-    const Scene scene = scene_with([&](Scene& s) {
-        for (int i = 0; i < 2000; ++i) {
-            const Vec3f p{u(rng) * 10, u(rng) * 10, u(rng) * 10};
-            s.add_triangle(p, p + Vec3f{0.2f, 0, 0}, p + Vec3f{0, 0.2f, 0.1f}, 0);
-        }
-        // Huge triangles across the whole box, a big sphere and a long thin cone.
-        s.add_triangle({-1, -1, 5}, {11, -1, 5.5f}, {5, 11, 4}, 0);
-        s.add_triangle({0, 0, 0}, {10, 10, 10}, {10, 0, 10}, 0);
-        s.add_sphere({5, 5, 5}, 3, 0);
-        s.add_cone({0, 10, 0}, 0.3f, {10, 0, 10}, 0.3f, 0);
-    });
+    const Scene scene = spanning_scene(rng);
     const auto octree = make_octree(scene);
     expect_well_formed(*octree, scene, OctreeConfig{});
     std::vector<std::size_t> leaves_of(scene.primitive_count(), 0);
     for (std::uint32_t p : octree->octree().refs) ++leaves_of[p];
     for (std::uint32_t p = 2000; p < 2004; ++p) EXPECT_GT(leaves_of[p], 20u) << p;
-    std::vector<Rayf> rays = random_rays(scene, rng, 3000, kOriginGrowth);
-    const std::vector<Rayf> adv = octree_adversarial_rays(octree->octree(), scene, rng);
-    rays.insert(rays.end(), adv.begin(), adv.end());
-    expect_agreement(scene, *octree, rays, "spanning");
 }
 
 TEST_F(Octree, UnsplittableNodesStayLeaves) {
