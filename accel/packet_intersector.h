@@ -38,10 +38,12 @@ struct PacketPrimitiveIntersector {
         hit.u = select(m, u, hit.u);
         hit.v = select(m, v, hit.v);
         ray.tfar = select(m, t, ray.tfar);
-        for (std::uint32_t bits = mask_bits(m); bits; bits &= bits - 1) {
-            const int l = std::countr_zero(bits);
-            hit.prim[l] = named ? ids[l] : prim;
-        }
+        // The primitive numbers blended as float bit patterns (a blend moves
+        // bits, it does no arithmetic): a lane-by-lane loop here cost
+        // mispredicted branches on every hit.
+        float* prims = reinterpret_cast<float*>(hit.prim);
+        const F numbers = named ? load_lanes<F>(reinterpret_cast<const float*>(ids)) : F(std::bit_cast<float>(prim));
+        store_lanes(prims, select(m, numbers, load_lanes<F>(prims)));
         return m;
     }
 

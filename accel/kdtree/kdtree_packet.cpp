@@ -13,11 +13,12 @@ namespace raypack {
 namespace {
 
 /// Lanes of `tie` hit prim at exactly the t they had before: restore the
-/// earlier hit where its primitive number is lower.
+/// earlier hit where its primitive number is lower. Rare, hence out of line:
+/// a call on the common path makes every live vector register spill.
 template <int K>
-void keep_lowest_on_ties(const vmask<K>& tie, const HitPacket<K>& before, HitPacket<K>& hit, std::uint32_t prim) {
+[[gnu::noinline, gnu::cold]] void keep_lowest_on_ties(const vmask<K>& tie, const HitPacket<K>& before,
+                                                      HitPacket<K>& hit, std::uint32_t prim) {
     std::uint32_t bits = mask_bits(tie);
-    if (!bits) return;
     // t too: +0 == -0, and the earlier hit keeps its own sign of zero.
     alignas(64) float t[K], u[K], v[K], bt[K], bu[K], bv[K];
     store_lanes(t, hit.t), store_lanes(u, hit.u), store_lanes(v, hit.v);
@@ -29,6 +30,37 @@ void keep_lowest_on_ties(const vmask<K>& tie, const HitPacket<K>& before, HitPac
     hit.t = load_lanes<vfloat<K>>(t);
     hit.u = load_lanes<vfloat<K>>(u);
     hit.v = load_lanes<vfloat<K>>(v);
+}
+
+/// The primitives a packet tested lately and on which lanes: a primitive
+/// spanning several leaves is tested again only on lanes it was not tested
+/// on (it would only find its own hit again). Direct-mapped: a collision
+/// forgets, which costs a test, never a hit.
+struct PacketMailbox {
+    static constexpr std::uint32_t kSlots = 16;
+    std::uint32_t prim[kSlots], lanes[kSlots];
+    PacketMailbox() { std::fill(std::begin(prim), std::end(prim), kNoPrim); }
+};
+
+/// Whether `prim` was tested on every lane of `lanes` already; records the test if not.
+RAYPACK_INLINE bool tested_before(PacketMailbox& box, std::uint32_t prim, std::uint32_t lanes) {
+    const std::uint32_t slot = prim % PacketMailbox::kSlots;
+    if (box.prim[slot] == prim) {
+        if (!(lanes & ~box.lanes[slot])) return true;
+        box.lanes[slot] |= lanes;
+    } else {
+        box.prim[slot] = prim, box.lanes[slot] = lanes;
+    }
+    return false;
+}
+
+/// Some lane of `tie_bits` had its hit on another primitive than `prim`
+/// (a primitive tested again in a later leaf ties with itself, often).
+template <int K>
+RAYPACK_INLINE bool ties_another_primitive(std::uint32_t tie_bits, const HitPacket<K>& before, std::uint32_t prim) {
+    for (; tie_bits; tie_bits &= tie_bits - 1)
+        if (before.prim[std::countr_zero(tie_bits)] != prim) return true;
+    return false;
 }
 
 /// The lanes of `m` get back their hit from `before`.
@@ -47,40 +79,73 @@ void restore_lanes(const vmask<K>& m, const HitPacket<K>& before, HitPacket<K>& 
 // widened planes, so every lane visits at least the leaves its single ray
 // would, and the same kernels, so the hits are bit for bit the same. A lane
 // is active in a node while tmin <= min(tmax, tfar).
-template <int K, bool AnyHit, SlabMethod Slabs>
+// SameSigns: every lane in the root box has the same direction signs (all
+// camera packets but those straddling the image's centre lines), so the
+// near child is the same for all lanes (Wald's thesis, 2004, 7.1): each
+// inner node costs two compares and no per-lane choice of child intervals.
+// The nodes visited and the hits are those of the general walk.
+template <int K, bool AnyHit, SlabMethod Slabs, bool SameSigns>
 void trace_packet(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>>& isect, RayPacket<K>& ray,
-                  HitPacket<K>& hit, vmask<K> valid, vmask<K>& occluded) {
+                  HitPacket<K>& hit, vmask<K> valid, vmask<K>& occluded, vmask<K> in_box, vfloat<K> tmin,
+                  vfloat<K> tmax) {
     using F = vfloat<K>;
     using M = vmask<K>;
     const F inf(std::numeric_limits<float>::infinity());
-    F tmin, tmax;
-    const M in_box = kd_ray_interval<F, Slabs>(valid, ray.org, ray.rdir, ray.tnear, ray.tfar, tree.bounds,
-                                               tree.margin, tmin, tmax);
-    if (none(in_box)) return;
     // Inactive lanes get an empty interval, which stays empty in every child.
     tmin = select(in_box, tmin, inf);
     tmax = select(in_box, tmax, -inf);
     constexpr bool plain = Slabs == SlabMethod::Plain;
     const F margin(plain ? 0.0f : tree.margin);
-    const Vec3<F> slack{margin * vabs(ray.rdir.x), margin * vabs(ray.rdir.y), margin * vabs(ray.rdir.z)};
-    const Vec3<F> org_rdir{ray.org.x * ray.rdir.x, ray.org.y * ray.rdir.y, ray.org.z * ray.rdir.z};
+    // What a split plane along each axis needs, indexed by the node's axis
+    // (Vec3's operator[] compiles to a chain of compares and blends).
+    struct AxisLanes {
+        F org, rdir, org_rdir, slack;
+    };
+    AxisLanes axes[3];
+    for (int a = 0; a < 3; ++a)
+        axes[a] = {ray.org[a], ray.rdir[a], ray.org[a] * ray.rdir[a], margin * vabs(ray.rdir[a])};
     const M positive[3] = {ray.rdir.x >= F(0.0f), ray.rdir.y >= F(0.0f), ray.rdir.z >= F(0.0f)};
+    // Bit a: the lanes' below child comes first along axis a (SameSigns).
+    const std::uint32_t lanes = mask_bits(in_box);
+    const std::uint32_t below_first_axes = std::uint32_t((mask_bits(positive[0]) & lanes) != 0) |
+                                           std::uint32_t((mask_bits(positive[1]) & lanes) != 0) << 1 |
+                                           std::uint32_t((mask_bits(positive[2]) & lanes) != 0) << 2;
     const bool double_ties = isect.kernels.precision == Precision::Double;
     const KdNode* nodes = tree.nodes.data();
-    struct PendingNode {
-        F tmin, tmax;
-        std::uint32_t node;
+    // The far children still to visit, with their intervals: lanes stored
+    // one by one (a struct of vectors made GCC copy them through scalar
+    // registers and keep tmax in memory).
+    alignas(64) float stack_tmin[kKdMaxDepth + 1][K], stack_tmax[kKdMaxDepth + 1][K];
+    std::uint32_t stack_node[kKdMaxDepth + 1];
+    const auto push = [&](int sp, const F& lo, const F& hi, std::uint32_t node) RAYPACK_INLINE_LAMBDA {
+        lo.store_aligned(stack_tmin[sp]);
+        hi.store_aligned(stack_tmax[sp]);
+        stack_node[sp] = node;
     };
-    PendingNode stack[kKdMaxDepth + 1];
     int sp = 0;
     std::uint32_t current = 0;
+    PacketMailbox mailbox;
     for (;;) {
         const KdNode node = nodes[current];
         if (!node.is_leaf()) {
             const int a = node.axis();
-            const F t_split = plane_distance<Slabs>(F(node.split()), ray.org[a], ray.rdir[a], org_rdir[a]);
-            const F near_end = vmin(tmax, plain ? t_split : t_split + slack[a]);
-            const F far_start = vmax(tmin, plain ? t_split : t_split - slack[a]);
+            const AxisLanes& axis = axes[a];
+            const F t_split = plane_distance<Slabs>(F(node.split()), axis.org, axis.rdir, axis.org_rdir);
+            const F near_end = vmin(tmax, plain ? t_split : t_split + axis.slack);
+            const F far_start = vmax(tmin, plain ? t_split : t_split - axis.slack);
+            if constexpr (SameSigns) {
+                const bool visit_near = any(tmin <= near_end), visit_far = any(far_start <= tmax);
+                const bool below_first = (below_first_axes >> a) & 1u;
+                const std::uint32_t near = below_first ? current + 1 : node.above_child();
+                const std::uint32_t far = below_first ? node.above_child() : current + 1;
+                if (visit_near) {
+                    if (visit_far) push(sp++, far_start, tmax, far);
+                    current = near, tmax = near_end;
+                } else {
+                    current = far, tmin = far_start;
+                }
+                continue;
+            }
             // Per lane, below is the near side where the direction is positive.
             const M pos = positive[a];
             const F below_lo = select(pos, tmin, far_start), below_hi = select(pos, near_end, tmax);
@@ -91,10 +156,10 @@ void trace_packet(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>
                 const std::uint32_t first = std::countr_zero(mask_bits(tmin <= tmax));
                 const bool below_first = (mask_bits(pos) >> first) & 1u;
                 if (below_first) {
-                    stack[sp++] = {above_lo, above_hi, node.above_child()};
+                    push(sp++, above_lo, above_hi, node.above_child());
                     current = current + 1, tmin = below_lo, tmax = below_hi;
                 } else {
-                    stack[sp++] = {below_lo, below_hi, current + 1};
+                    push(sp++, below_lo, below_hi, current + 1);
                     current = node.above_child(), tmin = above_lo, tmax = above_hi;
                 }
             } else if (any_below) {
@@ -108,6 +173,7 @@ void trace_packet(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>
         const std::uint32_t* prims = tree.leaf_prims(nodes[current]);
         M active = tmin <= tmax;
         for (std::uint32_t k = 0; k < count; ++k) {
+            if (tested_before(mailbox, prims[k], mask_bits(active))) continue;
             if constexpr (AnyHit) {
                 const M m = isect.intersect(active, ray, hit, prims[k]);
                 occluded = occluded | m;
@@ -121,12 +187,16 @@ void trace_packet(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>
                 const M farther = m & (hit.t > before.t);
                 if (any(farther)) restore_lanes<K>(farther, before, hit);
                 ray.tfar = select(m & !farther, hit.t, tfar);
-                if (any(m)) keep_lowest_on_ties<K>(m & !farther & (hit.t == before.t), before, hit, prims[k]);
+                const M tie = m & !farther & (hit.t == before.t);
+                if (any(tie)) [[unlikely]]
+                    keep_lowest_on_ties<K>(tie, before, hit, prims[k]);
             } else {
                 const HitPacket<K> before = hit;
                 const M m = isect.intersect(active, ray, hit, prims[k]);
                 // Equal t: the lowest primitive number wins, as in the single-ray path.
-                if (any(m)) keep_lowest_on_ties<K>(m & (hit.t == before.t), before, hit, prims[k]);
+                const M tie = m & (hit.t == before.t);
+                if (ties_another_primitive<K>(mask_bits(tie), before, prims[k])) [[unlikely]]
+                    keep_lowest_on_ties<K>(tie, before, hit, prims[k]);
             }
         }
         if constexpr (AnyHit) {
@@ -136,13 +206,14 @@ void trace_packet(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>
         // Pop the next node some lane reaches before its closest hit so far.
         for (;;) {
             if (sp == 0) return;
-            const PendingNode& t = stack[--sp];
-            M live = t.tmin <= vmin(t.tmax, ray.tfar);
+            --sp;
+            const F lo = F::load_aligned(stack_tmin[sp]), hi = vmin(F::load_aligned(stack_tmax[sp]), ray.tfar);
+            M live = lo <= hi;
             if constexpr (AnyHit) live = live & valid;
             if (any(live)) {
-                current = t.node;
-                tmin = select(live, t.tmin, inf);
-                tmax = select(live, vmin(t.tmax, ray.tfar), -inf);
+                current = stack_node[sp];
+                tmin = select(live, lo, inf);
+                tmax = select(live, hi, -inf);
                 break;
             }
         }
@@ -161,7 +232,20 @@ void kdtree_trace_packets(const KdTree& tree, const Scene& scene, KernelChoice k
         trace_in_packets<K, AnyHit>(rays, hits, kernels.rcp, [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid,
                                                     vmask<K>& occluded) {
             if (tree.empty()) return;
-            trace_packet<K, AnyHit, Slabs>(tree, isect, ray, hit, valid, occluded);
+            vfloat<K> tmin, tmax;
+            const vmask<K> in_box = kd_ray_interval<vfloat<K>, Slabs>(valid, ray.org, ray.rdir, ray.tnear, ray.tfar,
+                                                                      tree.bounds, tree.margin, tmin, tmax);
+            const std::uint32_t lanes = mask_bits(in_box);
+            if (!lanes) return;
+            bool same_signs = true;
+            for (const auto& d : {ray.rdir.x, ray.rdir.y, ray.rdir.z}) {
+                const std::uint32_t positive = mask_bits(d >= vfloat<K>(0.0f)) & lanes;
+                same_signs = same_signs && (positive == 0 || positive == lanes);
+            }
+            if (same_signs)
+                trace_packet<K, AnyHit, Slabs, true>(tree, isect, ray, hit, valid, occluded, in_box, tmin, tmax);
+            else
+                trace_packet<K, AnyHit, Slabs, false>(tree, isect, ray, hit, valid, occluded, in_box, tmin, tmax);
         });
     });
 }
