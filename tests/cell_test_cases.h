@@ -174,8 +174,8 @@ inline std::vector<SplitPlane> split_planes(const raypack::KdTree& tree) {
         Box3f below = voxel, above = voxel;
         below.hi[node.axis()] = node.split();
         above.lo[node.axis()] = node.split();
-        walk(n + 1, below);
-        walk(node.above_child(), above);
+        if (node.below_child(n)) walk(node.below_child(n), below);  // 0: empty space
+        if (node.above_child()) walk(node.above_child(), above);
     };
     walk(0, tree.bounds);
     return planes;

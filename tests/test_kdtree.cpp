@@ -58,9 +58,14 @@ void expect_well_formed(const KdTreeAccel& accel, const Scene& scene) {
     const raypack::KdTree& t = accel.tree();
     std::size_t leaves = 0, empty = 0, refs = 0;
     int depth = 0;
+    std::size_t empty_spaces = 0;
     std::function<void(std::uint32_t, const Box3f&, int)> walk = [&](std::uint32_t n, const Box3f& voxel, int d) {
-        ASSERT_LT(n, t.nodes.size());
         depth = std::max(depth, d);
+        if (n == 0 && d > 0) {  // empty space: an empty leaf without a node
+            ++leaves, ++empty, ++empty_spaces;
+            return;
+        }
+        ASSERT_LT(n, t.nodes.size());
         const KdNode& node = t.nodes[n];
         if (node.is_leaf()) {
             ++leaves;
@@ -80,14 +85,20 @@ void expect_well_formed(const KdTreeAccel& accel, const Scene& scene) {
         const int a = node.axis();
         EXPECT_GT(node.split(), voxel.lo[a]);
         EXPECT_LT(node.split(), voxel.hi[a]);
-        EXPECT_GT(node.above_child(), n + 1);
+        // The above child comes after the below subtree (or right after its
+        // parent when the below side is empty); never both sides empty.
+        EXPECT_TRUE(node.above_child() == 0 || node.above_child() > n) << n;
+        EXPECT_TRUE(node.below_child(n) != 0 || node.above_child() != 0) << n;
         Box3f below = voxel, above = voxel;
         below.hi[a] = node.split();
         above.lo[a] = node.split();
-        walk(n + 1, below, d + 1);
+        walk(node.below_child(n), below, d + 1);
         walk(node.above_child(), above, d + 1);
     };
     if (!t.empty()) walk(0, t.bounds, 0);
+    // Empty space has no node: the tree's nodes are its inner nodes and
+    // leaves but the empty ones it stands for.
+    EXPECT_EQ(t.nodes.size() + empty_spaces, 2 * t.leaves - 1);
     EXPECT_EQ(leaves, t.leaves);
     EXPECT_EQ(empty, accel.empty_leaves());
     EXPECT_EQ(refs, t.references);

@@ -32,6 +32,11 @@ struct KdTreeConfig {
 /// (upper 30 bits; the below child follows its parent). Leaf: low bits 3,
 /// upper 30 bits the primitive count, and `word` the primitive itself when
 /// there is one, else the offset of its primitives in KdTree::prim_index.
+/// Empty leaves have no node (half the leaves a camera packet reaches were
+/// empty: each cost a visit and a pop): a child index of 0, which no child
+/// has, stands for empty space; an empty below child is written as the
+/// above child following its parent. Only a split with both sides empty
+/// stays, as an empty leaf.
 struct KdNode {
     std::uint32_t word = 0;
     std::uint32_t bits = 3;
@@ -44,6 +49,8 @@ struct KdNode {
     bool is_leaf() const { return (bits & 3u) == 3u; }
     int axis() const { return int(bits & 3u); }
     float split() const { return std::bit_cast<float>(word); }
+    /// Children of the inner node at index `self`; 0 = empty space.
+    std::uint32_t below_child(std::uint32_t self) const { return above_child() == self + 1 ? 0 : self + 1; }
     std::uint32_t above_child() const { return bits >> 2; }
     std::uint32_t prim_count() const { return bits >> 2; }
 };
@@ -61,8 +68,8 @@ struct KdTree {
     /// plane are found on either side: see kdtree_margin().
     float margin = 0;
     int depth = 0;
-    std::size_t leaves = 0;
-    std::size_t empty_leaves = 0;
+    std::size_t leaves = 0;        ///< leaves of the SAH build, empty ones included
+    std::size_t empty_leaves = 0;  ///< leaves without primitives (most have no node)
     std::size_t references = 0;  ///< primitive references over all leaves
     double sah_cost = 0;         ///< expected cost of a random ray, in traversal-cost units
 

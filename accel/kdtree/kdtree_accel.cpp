@@ -56,6 +56,13 @@ namespace {
     ray.tfar = hit.t;
 }
 
+/// The counting walk's visit of empty space: the empty leaf it stands for.
+inline void count_empty_leaf(KdRayCounters* counters, bool visited) {
+    counters->nodes_visited += visited;
+    counters->leaves_visited += visited;
+    counters->empty_leaves_visited += visited;
+}
+
 }  // namespace
 
 // Front-to-back traversal with a stack of far children and their intervals
@@ -104,45 +111,54 @@ bool KdTreeAccel::walk(Rayf& ray, Hitf& hit, KdRayCounters* counters) const {
             const float near_end = plain ? t_split : t_split + slack[a];
             const float far_start = plain ? t_split : t_split - slack[a];
             const bool below_first = rdir[a] >= 0.0f;
-            const std::uint32_t near = below_first ? current + 1 : node.above_child();
-            const std::uint32_t far = below_first ? node.above_child() : current + 1;
-            const bool visit_near = near_end >= tmin, visit_far = far_start <= tmax;
-            if (visit_near && visit_far) {
-                stack[sp++] = {far, std::max(tmin, far_start), tmax};
+            const std::uint32_t below = node.below_child(current), above = node.above_child();
+            const std::uint32_t near = below_first ? below : above;
+            const std::uint32_t far = below_first ? above : below;
+            // (A ray that misses the near side takes the far one even if a
+            // NaN distance misses both.)
+            const bool visit_near = near_end >= tmin, visit_far = far_start <= tmax || !visit_near;
+            // Empty space (child 0) is not visited; the counting walk counts
+            // it as the empty leaf it stands for (pushed, it counts when popped).
+            if (visit_near && near) {
+                if (visit_far && (far || Counting)) stack[sp++] = {far, std::max(tmin, far_start), tmax};
                 current = near;
                 tmax = std::min(tmax, near_end);
-            } else if (visit_near) {
-                current = near;
-                tmax = std::min(tmax, near_end);
-            } else {
+                continue;
+            }
+            if constexpr (Counting) count_empty_leaf(counters, visit_near);
+            // Past empty space the far side is entered as if popped: only if
+            // it starts before the closest hit so far.
+            if (visit_far && far && (!visit_near || std::max(tmin, far_start) <= ray.tfar)) {
                 current = far;
                 tmin = std::max(tmin, far_start);
+                continue;
             }
-            continue;
-        }
-        const std::uint32_t count = node.prim_count();
-        if constexpr (Counting) {
-            ++counters->leaves_visited;
-            counters->empty_leaves_visited += count == 0;
-            counters->prim_tests += count;
-        }
-        const std::uint32_t* prims = tree_.leaf_prims(nodes[current]);
-        for (std::uint32_t k = 0; k < count; ++k) {
-            const Hitf before = hit;
-            if constexpr (!AnyHit) {
-                if (double_ties && found) [[unlikely]] {
-                    test_after_hit_in_double(isect, prims[k], ray, hit);
-                    continue;
+            if constexpr (Counting) count_empty_leaf(counters, visit_far && !visit_near);
+        } else {
+            const std::uint32_t count = node.prim_count();
+            if constexpr (Counting) {
+                ++counters->leaves_visited;
+                counters->empty_leaves_visited += count == 0;
+                counters->prim_tests += count;
+            }
+            const std::uint32_t* prims = tree_.leaf_prims(nodes[current]);
+            for (std::uint32_t k = 0; k < count; ++k) {
+                const Hitf before = hit;
+                if constexpr (!AnyHit) {
+                    if (double_ties && found) [[unlikely]] {
+                        test_after_hit_in_double(isect, prims[k], ray, hit);
+                        continue;
+                    }
                 }
-            }
-            if (isect.intersect(prims[k], ray, hit)) {
-                found = true;
-                if constexpr (AnyHit) return true;
-                // The kernels accept t == tfar, so of several primitives at
-                // exactly the same t the last one tested would win: keep the
-                // lowest number instead, which makes the answer independent
-                // of the visiting order (packets order nodes by one lane).
-                if (hit.t == before.t && before.prim < prims[k]) hit = before;
+                if (isect.intersect(prims[k], ray, hit)) {
+                    found = true;
+                    if constexpr (AnyHit) return true;
+                    // The kernels accept t == tfar, so of several primitives at
+                    // exactly the same t the last one tested would win: keep the
+                    // lowest number instead, which makes the answer independent
+                    // of the visiting order (packets order nodes by one lane).
+                    if (hit.t == before.t && before.prim < prims[k]) hit = before;
+                }
             }
         }
         // Pop the next node the ray reaches before its closest hit so far.
@@ -150,6 +166,10 @@ bool KdTreeAccel::walk(Rayf& ray, Hitf& hit, KdRayCounters* counters) const {
             if (sp == 0) return found;
             const PendingNode& t = stack[--sp];
             if (t.tmin <= ray.tfar) {
+                if (Counting && t.node == 0) {
+                    count_empty_leaf(counters, true);
+                    continue;
+                }
                 current = t.node;
                 tmin = t.tmin;
                 tmax = t.tmax;

@@ -65,7 +65,7 @@ public:
     }
 
     /// Builds the subtree of `voxel` from its sorted events (consumed);
-    /// returns its node index.
+    /// returns its node index, or 0 for empty space (no node).
     std::uint32_t build(std::vector<Event>&& events, std::size_t n, const Box3f& voxel, int depth, KdTree& tree) {
         // Child indices and leaf counts have 30 bits in a KdNode.
         if (tree.nodes.size() >= (std::size_t(1) << 30) || n >= (std::size_t(1) << 30))
@@ -81,7 +81,9 @@ public:
         if (!(plane.cost < leaf_cost)) {
             make_leaf(events, n, tree, index);
             tree.sah_cost += double(area) / root_area_ * double(leaf_cost);
-            return index;
+            if (n > 0) return index;
+            tree.nodes.pop_back();  // empty space: no node (see KdNode)
+            return 0;
         }
         tree.sah_cost += double(area) / root_area_ * double(config_.traversal_cost);
 
@@ -132,7 +134,7 @@ public:
         std::vector<Event>().swap(right_only);
         std::vector<Event>().swap(right_new);
 
-        std::uint32_t above;
+        std::uint32_t below, above;
         if (n > kParallelPrims && depth < kParallelDepth) {
             // The two subtrees at once, each into a tree of its own (the
             // right one with its own copy of the side marks), spliced in the
@@ -142,12 +144,20 @@ public:
             tbb::parallel_invoke(
                 [&] { build(std::move(left), n_left, left_voxel, depth + 1, below_part); },
                 [&] { right_builder.build(std::move(right), n_right, right_voxel, depth + 1, above_part); });
-            splice(below_part, tree);
+            below = splice(below_part, tree);
             above = splice(above_part, tree);
         } else {
-            build(std::move(left), n_left, left_voxel, depth + 1, tree);
+            below = build(std::move(left), n_left, left_voxel, depth + 1, tree);
             above = build(std::move(right), n_right, right_voxel, depth + 1, tree);
         }
+        if (!below && !above) {
+            // Both sides empty (primitives clipped away from both): an empty
+            // leaf, which a child index cannot express, in place of two.
+            tree.nodes[index] = KdNode::leaf(0, 0);
+            --tree.leaves, --tree.empty_leaves;
+            return index;
+        }
+        // An empty below side leaves the above child right after its parent.
         tree.nodes[index] = KdNode::inner(plane.axis, plane.pos, above);
         return index;
     }
@@ -159,15 +169,19 @@ public:
     static constexpr int kParallelDepth = 4;
 
     /// Appends `part` (a subtree built on its own, root at 0) to `tree`;
-    /// returns the index of its root there.
+    /// returns the index of its root there, 0 if the part is empty space.
     static std::uint32_t splice(const KdTree& part, KdTree& tree) {
         const std::size_t base = tree.nodes.size(), prim_base = tree.prim_index.size();
         if (base + part.nodes.size() >= (std::size_t(1) << 30) ||
             prim_base + part.prim_index.size() >= (std::size_t(1) << 32) - 1)
             throw std::length_error("kdtree: more than 2^30 nodes or 2^32 references");
         for (KdNode node : part.nodes) {
-            if (!node.is_leaf()) node = KdNode::inner(node.axis(), node.split(), node.above_child() + std::uint32_t(base));
-            else if (node.prim_count() > 1) node = KdNode::leaf(node.prim_count(), node.word + std::uint32_t(prim_base));
+            if (!node.is_leaf()) {
+                if (node.above_child() != 0)  // 0: empty space
+                    node = KdNode::inner(node.axis(), node.split(), node.above_child() + std::uint32_t(base));
+            } else if (node.prim_count() > 1) {
+                node = KdNode::leaf(node.prim_count(), node.word + std::uint32_t(prim_base));
+            }
             tree.nodes.push_back(node);
         }
         tree.prim_index.insert(tree.prim_index.end(), part.prim_index.begin(), part.prim_index.end());
@@ -176,7 +190,7 @@ public:
         tree.empty_leaves += part.empty_leaves;
         tree.references += part.references;
         tree.sah_cost += part.sah_cost;
-        return std::uint32_t(base);
+        return part.nodes.empty() ? 0 : std::uint32_t(base);
     }
 
     int max_depth_ = 0;

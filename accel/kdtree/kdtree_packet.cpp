@@ -32,6 +32,11 @@ template <int K>
     hit.v = load_lanes<vfloat<K>>(v);
 }
 
+template <class F>
+RAYPACK_INLINE F select_if(bool c, const F& a, const F& b) {
+    return c ? a : b;
+}
+
 /// The primitives a packet tested lately and on which lanes: a primitive
 /// spanning several leaves is tested again only on lanes it was not tested
 /// on (it would only find its own hit again). Direct-mapped: a collision
@@ -125,6 +130,18 @@ void trace_packet(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>
     int sp = 0;
     std::uint32_t current = 0;
     PacketMailbox mailbox;
+    // Enters `node` with the lanes that reach it before their closest hit so
+    // far (all there is to a pop); false if there are none.
+    const auto resume = [&](const F& lo, const F& hi_before_hits, std::uint32_t node) RAYPACK_INLINE_LAMBDA {
+        const F hi = vmin(hi_before_hits, ray.tfar);
+        M live = lo <= hi;
+        if constexpr (AnyHit) live = live & valid;
+        if (none(live)) return false;
+        current = node;
+        tmin = select(live, lo, inf);
+        tmax = select(live, hi, -inf);
+        return true;
+    };
     for (;;) {
         const KdNode node = nodes[current];
         if (!node.is_leaf()) {
@@ -136,86 +153,87 @@ void trace_packet(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>
             if constexpr (SameSigns) {
                 const bool visit_near = any(tmin <= near_end), visit_far = any(far_start <= tmax);
                 const bool below_first = (below_first_axes >> a) & 1u;
-                const std::uint32_t near = below_first ? current + 1 : node.above_child();
-                const std::uint32_t far = below_first ? node.above_child() : current + 1;
-                if (visit_near) {
-                    if (visit_far) push(sp++, far_start, tmax, far);
+                const std::uint32_t below = node.below_child(current), above = node.above_child();
+                const std::uint32_t near = below_first ? below : above;
+                const std::uint32_t far = below_first ? above : below;
+                // Child 0 is empty space: not visited (see KdNode).
+                if (visit_near && near) {
+                    if (visit_far && far) push(sp++, far_start, tmax, far);
                     current = near, tmax = near_end;
-                } else {
+                    continue;
+                }
+                if (!visit_near && far) {
                     current = far, tmin = far_start;
+                    continue;
                 }
-                continue;
-            }
-            // Per lane, below is the near side where the direction is positive.
-            const M pos = positive[a];
-            const F below_lo = select(pos, tmin, far_start), below_hi = select(pos, near_end, tmax);
-            const F above_lo = select(pos, far_start, tmin), above_hi = select(pos, tmax, near_end);
-            const bool any_below = any(below_lo <= below_hi), any_above = any(above_lo <= above_hi);
-            if (any_below && any_above) {
-                // Front to back for the first active lane.
+                // Past empty space the far side is entered as if popped.
+                if (visit_far && far && resume(far_start, tmax, far)) continue;
+            } else {
+                // Per lane, below is the near side where the direction is positive.
+                const M pos = positive[a];
+                const F below_lo = select(pos, tmin, far_start), below_hi = select(pos, near_end, tmax);
+                const F above_lo = select(pos, far_start, tmin), above_hi = select(pos, tmax, near_end);
+                const bool any_below = any(below_lo <= below_hi), any_above = any(above_lo <= above_hi);
+                const std::uint32_t below = node.below_child(current), above = node.above_child();
+                // Front to back for the first active lane; the packet takes
+                // the above side when it finds no lane below.
                 const std::uint32_t first = std::countr_zero(mask_bits(tmin <= tmax));
-                const bool below_first = (mask_bits(pos) >> first) & 1u;
-                if (below_first) {
-                    push(sp++, above_lo, above_hi, node.above_child());
-                    current = current + 1, tmin = below_lo, tmax = below_hi;
-                } else {
-                    push(sp++, below_lo, below_hi, current + 1);
-                    current = node.above_child(), tmin = above_lo, tmax = above_hi;
+                const bool below_first = any_below && (!any_above || ((mask_bits(pos) >> first) & 1u));
+                const bool visit_second = any_below && any_above;
+                const std::uint32_t first_child = below_first ? below : above;
+                const std::uint32_t second_child = below_first ? above : below;
+                const F first_lo = select_if(below_first, below_lo, above_lo);
+                const F first_hi = select_if(below_first, below_hi, above_hi);
+                const F second_lo = select_if(below_first, above_lo, below_lo);
+                const F second_hi = select_if(below_first, above_hi, below_hi);
+                if (first_child) {
+                    if (visit_second && second_child) push(sp++, second_lo, second_hi, second_child);
+                    current = first_child, tmin = first_lo, tmax = first_hi;
+                    continue;
                 }
-            } else if (any_below) {
-                current = current + 1, tmin = below_lo, tmax = below_hi;
-            } else {
-                current = node.above_child(), tmin = above_lo, tmax = above_hi;
+                if (visit_second && second_child && resume(second_lo, second_hi, second_child)) continue;
             }
-            continue;
-        }
-        const std::uint32_t count = node.prim_count();
-        const std::uint32_t* prims = tree.leaf_prims(nodes[current]);
-        M active = tmin <= tmax;
-        for (std::uint32_t k = 0; k < count; ++k) {
-            if (tested_before(mailbox, prims[k], mask_bits(active))) continue;
+        } else {
+            const std::uint32_t count = node.prim_count();
+            const std::uint32_t* prims = tree.leaf_prims(nodes[current]);
+            M active = tmin <= tmax;
+            for (std::uint32_t k = 0; k < count; ++k) {
+                if (tested_before(mailbox, prims[k], mask_bits(active))) continue;
+                if constexpr (AnyHit) {
+                    const M m = isect.intersect(active, ray, hit, prims[k]);
+                    occluded = occluded | m;
+                    active = active & !m;
+                    if (none(active)) break;
+                } else if (double_ties) {  // see kd_tie_tfar()
+                    const HitPacket<K> before = hit;
+                    const F tfar = ray.tfar;
+                    ray.tfar = select(active & (before.t < inf), kd_tie_tfar(tfar), tfar);
+                    const M m = isect.intersect(active, ray, hit, prims[k]);
+                    const M farther = m & (hit.t > before.t);
+                    if (any(farther)) restore_lanes<K>(farther, before, hit);
+                    ray.tfar = select(m & !farther, hit.t, tfar);
+                    const M tie = m & !farther & (hit.t == before.t);
+                    if (any(tie)) [[unlikely]]
+                        keep_lowest_on_ties<K>(tie, before, hit, prims[k]);
+                } else {
+                    const HitPacket<K> before = hit;
+                    const M m = isect.intersect(active, ray, hit, prims[k]);
+                    // Equal t: the lowest primitive number wins, as in the single-ray path.
+                    const M tie = m & (hit.t == before.t);
+                    if (ties_another_primitive<K>(mask_bits(tie), before, prims[k])) [[unlikely]]
+                        keep_lowest_on_ties<K>(tie, before, hit, prims[k]);
+                }
+            }
             if constexpr (AnyHit) {
-                const M m = isect.intersect(active, ray, hit, prims[k]);
-                occluded = occluded | m;
-                active = active & !m;
-                if (none(active)) break;
-            } else if (double_ties) {  // see kd_tie_tfar()
-                const HitPacket<K> before = hit;
-                const F tfar = ray.tfar;
-                ray.tfar = select(active & (before.t < inf), kd_tie_tfar(tfar), tfar);
-                const M m = isect.intersect(active, ray, hit, prims[k]);
-                const M farther = m & (hit.t > before.t);
-                if (any(farther)) restore_lanes<K>(farther, before, hit);
-                ray.tfar = select(m & !farther, hit.t, tfar);
-                const M tie = m & !farther & (hit.t == before.t);
-                if (any(tie)) [[unlikely]]
-                    keep_lowest_on_ties<K>(tie, before, hit, prims[k]);
-            } else {
-                const HitPacket<K> before = hit;
-                const M m = isect.intersect(active, ray, hit, prims[k]);
-                // Equal t: the lowest primitive number wins, as in the single-ray path.
-                const M tie = m & (hit.t == before.t);
-                if (ties_another_primitive<K>(mask_bits(tie), before, prims[k])) [[unlikely]]
-                    keep_lowest_on_ties<K>(tie, before, hit, prims[k]);
+                valid = valid & !occluded;
+                if (none(valid)) return;
             }
-        }
-        if constexpr (AnyHit) {
-            valid = valid & !occluded;
-            if (none(valid)) return;
         }
         // Pop the next node some lane reaches before its closest hit so far.
         for (;;) {
             if (sp == 0) return;
             --sp;
-            const F lo = F::load_aligned(stack_tmin[sp]), hi = vmin(F::load_aligned(stack_tmax[sp]), ray.tfar);
-            M live = lo <= hi;
-            if constexpr (AnyHit) live = live & valid;
-            if (any(live)) {
-                current = stack_node[sp];
-                tmin = select(live, lo, inf);
-                tmax = select(live, hi, -inf);
-                break;
-            }
+            if (resume(F::load_aligned(stack_tmin[sp]), F::load_aligned(stack_tmax[sp]), stack_node[sp])) break;
         }
     }
 }
