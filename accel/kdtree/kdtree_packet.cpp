@@ -147,7 +147,10 @@ void trace_packet(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>
         if (!node.is_leaf()) {
             const int a = node.axis();
             const AxisLanes& axis = axes[a];
-            const F t_split = plane_distance<Slabs>(F(node.split()), axis.org, axis.rdir, axis.org_rdir);
+            // The split broadcast straight from the node (through a scalar
+            // register it added two steps to every node's latency).
+            const F split = F(*reinterpret_cast<const float*>(&nodes[current].word));
+            const F t_split = plane_distance<Slabs>(split, axis.org, axis.rdir, axis.org_rdir);
             const F near_end = vmin(tmax, plain ? t_split : t_split + axis.slack);
             const F far_start = vmax(tmin, plain ? t_split : t_split - axis.slack);
             if constexpr (SameSigns) {
