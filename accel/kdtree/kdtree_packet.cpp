@@ -7,6 +7,7 @@
 #include "accel/kdtree/kdtree_ray_interval.h"
 #include "accel/packet_driver.h"
 #include "accel/packet_intersector.h"
+#include "accel/packet_mailbox.h"
 #include "kernels/ray_packet.h"
 
 namespace raypack {
@@ -35,28 +36,6 @@ template <int K>
 template <class F>
 RAYPACK_INLINE F select_if(bool c, const F& a, const F& b) {
     return c ? a : b;
-}
-
-/// The primitives a packet tested lately and on which lanes: a primitive
-/// spanning several leaves is tested again only on lanes it was not tested
-/// on (it would only find its own hit again). Direct-mapped: a collision
-/// forgets, which costs a test, never a hit.
-struct PacketMailbox {
-    static constexpr std::uint32_t kSlots = 16;
-    std::uint32_t prim[kSlots], lanes[kSlots];
-    PacketMailbox() { std::fill(std::begin(prim), std::end(prim), kNoPrim); }
-};
-
-/// Whether `prim` was tested on every lane of `lanes` already; records the test if not.
-RAYPACK_INLINE bool tested_before(PacketMailbox& box, std::uint32_t prim, std::uint32_t lanes) {
-    const std::uint32_t slot = prim % PacketMailbox::kSlots;
-    if (box.prim[slot] == prim) {
-        if (!(lanes & ~box.lanes[slot])) return true;
-        box.lanes[slot] |= lanes;
-    } else {
-        box.prim[slot] = prim, box.lanes[slot] = lanes;
-    }
-    return false;
 }
 
 /// Some lane of `tie_bits` had its hit on another primitive than `prim`
@@ -201,7 +180,10 @@ void trace_packet(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>
             const std::uint32_t* prims = tree.leaf_prims(nodes[current]);
             M active = tmin <= tmax;
             for (std::uint32_t k = 0; k < count; ++k) {
-                if (tested_before(mailbox, prims[k], mask_bits(active))) continue;
+                // A test again only finds its own hit: ties go to the lowest primitive.
+                std::uint32_t& settled = mailbox.settled(prims[k]);
+                if (!(mask_bits(active) & ~settled)) continue;
+                settled |= mask_bits(active);
                 if constexpr (AnyHit) {
                     const M m = isect.intersect(active, ray, hit, prims[k]);
                     occluded = occluded | m;
