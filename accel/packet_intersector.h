@@ -3,6 +3,7 @@
 // step of every packet traversal. Structures never look at primitive kinds.
 #include <bit>
 #include <cstdint>
+#include <type_traits>
 
 #include "accel/primitive_intersector.h"
 #include "accel/prims/prim_kinds.h"
@@ -38,12 +39,18 @@ struct PacketPrimitiveIntersector {
         hit.u = select(m, u, hit.u);
         hit.v = select(m, v, hit.v);
         ray.tfar = select(m, t, ray.tfar);
-        // The primitive numbers blended as float bit patterns (a blend moves
-        // bits, it does no arithmetic): a lane-by-lane loop here cost
-        // mispredicted branches on every hit.
-        float* prims = reinterpret_cast<float*>(hit.prim);
-        const F numbers = named ? load_lanes<F>(reinterpret_cast<const float*>(ids)) : F(std::bit_cast<float>(prim));
-        store_lanes(prims, select(m, numbers, load_lanes<F>(prims)));
+        if constexpr (std::is_floating_point_v<F>) {
+            hit.prim[0] = named ? ids[0] : prim;
+        } else {
+            // The primitive numbers blended as float bit patterns (a blend
+            // moves bits, it does no arithmetic; the vector loads and stores
+            // may alias): a lane-by-lane loop here cost mispredicted
+            // branches on every hit.
+            float* prims = reinterpret_cast<float*>(hit.prim);
+            const F numbers = named ? F::load_unaligned(reinterpret_cast<const float*>(ids))
+                                    : F(std::bit_cast<float>(prim));
+            select(m, numbers, F::load_unaligned(prims)).store_unaligned(prims);
+        }
         return m;
     }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cstring>
 #include <limits>
 
 #include "accel/kdtree/kdtree_ray_interval.h"
@@ -128,7 +129,9 @@ void trace_packet(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>
             const AxisLanes& axis = axes[a];
             // The split broadcast straight from the node (through a scalar
             // register it added two steps to every node's latency).
-            const F split = F(*reinterpret_cast<const float*>(&nodes[current].word));
+            float split_pos;
+            std::memcpy(&split_pos, &nodes[current].word, sizeof split_pos);
+            const F split(split_pos);
             const F t_split = plane_distance<Slabs>(split, axis.org, axis.rdir, axis.org_rdir);
             const F near_end = vmin(tmax, plain ? t_split : t_split + axis.slack);
             const F far_start = vmax(tmin, plain ? t_split : t_split - axis.slack);
