@@ -140,16 +140,13 @@ inline std::vector<Rayf> octree_adversarial_rays(const Octree& tree, const Scene
     // 6. Through node corners, and from node corners.
     append_corner_rays(rays, rng, box, corner, 900);
     // 7. Along node diagonals: ties between all three axes at every midplane.
-    for (int i = 0; i < 300; ++i) {
-        Rayf r;
-        const float s = side / float(1 << (1 + rng() % 5));
-        Vec3f d{s, s, s};
-        for (int a = 0; a < 3; ++a)
-            if (rng() % 2) d[a] = -d[a];
-        r.org = corner() - d * float(1 + rng() % 4);
-        r.dir = d;
-        rays.push_back(r);
-    }
+    append_diagonal_rays(
+        rays, rng,
+        [&] {
+            const float s = side / float(1 << (1 + rng() % 5));
+            return Vec3f{s, s, s};
+        },
+        corner, 300);
     // 8. From far away (10 cube diagonals), aimed into the cube.
     append_far_rays(rays, rng, box, 300);
     // 9. Aimed at triangle vertices and sphere poles.

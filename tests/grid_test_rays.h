@@ -78,15 +78,7 @@ inline std::vector<Rayf> grid_adversarial_rays(const GridGeometry& g, const Scen
     // 5. Through cell corners, and from cell corners.
     append_corner_rays(rays, rng, box, corner, 900);
     // 6. Along cell diagonals: ties between all three axes at every step.
-    for (int i = 0; i < 300; ++i) {
-        Rayf r;
-        Vec3f d = g.cell_size;
-        for (int a = 0; a < 3; ++a)
-            if (rng() % 2) d[a] = -d[a];
-        r.org = corner() - d * float(1 + rng() % 4);
-        r.dir = d;
-        rays.push_back(r);
-    }
+    append_diagonal_rays(rays, rng, [&] { return g.cell_size; }, corner, 300);
     // 7. From far away (10 grid diagonals), aimed into the grid.
     append_far_rays(rays, rng, box, 300);
     // 8. On the grid's faces, the far ones included: inwards and along the face.

@@ -326,6 +326,22 @@ inline void append_face_rays(std::vector<Rayf>& rays, std::mt19937& rng, const B
     }
 }
 
+/// `n` rays along cell diagonals through cell corners (`corner()`), from 1 to
+/// 4 diagonals before one: ties between all three axes at every plane.
+/// `diagonal()` gives a diagonal's extent before its signs are drawn.
+template <class Diagonal, class Corner>
+void append_diagonal_rays(std::vector<Rayf>& rays, std::mt19937& rng, Diagonal&& diagonal, Corner&& corner, int n) {
+    for (int i = 0; i < n; ++i) {
+        Rayf r;
+        Vec3f d = diagonal();
+        for (int a = 0; a < 3; ++a)
+            if (rng() % 2) d[a] = -d[a];
+        r.org = corner() - d * float(1 + rng() % 4);
+        r.dir = d;
+        rays.push_back(r);
+    }
+}
+
 /// n rays from far away (10 diagonals of `box`), each aimed at a random point of it.
 inline void append_far_rays(std::vector<Rayf>& rays, std::mt19937& rng, const Box3f& box, int n) {
     const float diag = length(box.extent());
