@@ -16,6 +16,7 @@
 #include "render/ray_offset.h"
 #include "render/sampler.h"
 #include "render/sampling.h"
+#include "render/shade_lanes.h"
 #include "render/surface.h"
 #include "render/thin_lens.h"
 #include "render/tiles.h"
@@ -123,7 +124,22 @@ public:
           offset_(options.offset, scene),
           surfaces_(scene),
           samples_(options.sampler, options.spp, options.seed),
-          timed_(!scene.moving_instances.empty()) {}
+          timed_(!scene.moving_instances.empty()),
+          // Vertices in SIMD lanes need the Epsilon or Scaled offset (the
+          // robust one reads the primitive) and a static scene.
+          lanes_(path.lanes && !timed_ && options.offset != OffsetPolicy::Robust && kShadeLanes > 1) {
+        parts_.reserve(scene.materials.size());
+        for (const Material& m : scene.materials) {
+            MaterialParts q;
+            q.albedo = m.color * m.kd;
+            q.wd = std::max(0.0f, max_component(q.albedo));
+            q.ws = std::max(0.0f, m.ks);
+            q.wt = std::max(0.0f, m.transmittance);
+            q.total = q.wd + q.ws + q.wt;
+            parts_.push_back(q);
+        }
+        for (const AreaLight& light : scene.area_lights) parallelograms_.push_back(sample_area_light(light, {}, {}));
+    }
 
     const Sampler& samples() const { return samples_; }
 
@@ -141,7 +157,10 @@ public:
             s.next.clear();
             s.shadows.clear();
             if (depth < path_.max_depth) draw_bounce(depth, s);
-            for (std::size_t i = 0; i < p.rays.size(); ++i) bounce(i, depth, s);
+            if (lanes_ && depth < path_.max_depth)
+                for (std::size_t i = 0; i < p.rays.size(); i += kShadeLanes) bounce_lanes(i, depth, s);
+            else
+                for (std::size_t i = 0; i < p.rays.size(); ++i) bounce(i, depth, s);
             trace_shadows(s);
             std::swap(s.paths, s.next);
         }
@@ -156,6 +175,17 @@ private:
     SurfaceTable surfaces_;
     Sampler samples_;
     bool timed_;  ///< the scene moves: every ray at its camera sample's time
+    bool lanes_;  ///< diffuse vertices in SIMD lanes (bounce_lanes)
+    /// Per material, bounce's weights of its diffuse, specular and
+    /// transmitting parts (computed as bounce computes them).
+    struct MaterialParts {
+        Vec3f albedo;
+        float wd, ws, wt, total;
+    };
+    std::vector<MaterialParts> parts_;
+    /// Per area light: a parallelogram's normal and density, which
+    /// sample_area_light computes for every sample (three divisions).
+    std::vector<LightSample> parallelograms_;
 
     /// The times of rays whose samples are `samples` (indices into the batch).
     static std::span<const float> times_of(std::span<const std::uint32_t> samples, Scratch& s) {
@@ -289,6 +319,258 @@ private:
         }
         if (!(max_component(next_beta) > 0)) return;
         spawn_ray(origin, dir, offset_, s.next.add(next_beta, si, specular, bounce_pdf, origin));
+    }
+
+    /// bounce() for the paths [i0, i0 + kShadeLanes), bit for bit: the
+    /// diffuse vertices (the common case) in SIMD lanes, with bounce's
+    /// operations in bounce's order (FMA contraction is off) and cos, sin
+    /// per lane; the others (misses, lights' surfaces, mirrors, glass) one
+    /// by one through bounce(). Rays and shadow rays are appended in path
+    /// order, as bounce() appends them. Needs depth < max_depth.
+    void bounce_lanes(std::size_t i0, int depth, Scratch& s) const {
+        constexpr int K = kShadeLanes;
+        using F = vfloat<K>;
+        const Paths& p = s.paths;
+        const int n = int(std::min<std::size_t>(K, p.rays.size() - i0));
+        // Gathered per lane: the diffuse vertices' ray direction, normals,
+        // hit point, albedo and part weights, throughput, draws.
+        alignas(64) float dir[3][K], gn[3][K], sn[3][K], point[3][K], albedo[3][K], beta[3][K];
+        alignas(64) float total[K], wd[K], roulette[K], u1[K], u2[K];
+        std::uint32_t diffuse = 0;
+        for (int l = 0; l < n; ++l) {
+            const std::size_t i = i0 + std::size_t(l);
+            const Hitf& hit = p.hits[i];
+            if (!hit.found()) continue;
+            const Rayf& ray = p.rays[i];
+            const Surface surf = surfaces_.at(ray, hit);
+            if (scene_.materials[surf.material].area_light >= 0) continue;
+            const MaterialParts& q = parts_[surf.material];
+            const Sample2 choice = drawn(s, i, 0);
+            if (!(q.total > 0) || !(choice.x * q.total < q.wd)) continue;
+            diffuse |= 1u << l;
+            const Vec3f b = p.throughput[i];
+            const Sample2 u = drawn(s, i, 3);
+            for (int a = 0; a < 3; ++a) {
+                dir[a][l] = ray.dir[a];
+                gn[a][l] = surf.geometric_normal[a];
+                sn[a][l] = surf.shading_normal[a];
+                point[a][l] = surf.point[a];
+                albedo[a][l] = q.albedo[a];
+                beta[a][l] = b[a];
+            }
+            total[l] = q.total;
+            wd[l] = q.wd;
+            roulette[l] = choice.y;
+            u1[l] = u.x;
+            u2[l] = u.y;
+        }
+        if (diffuse == 0) {
+            for (int l = 0; l < n; ++l) bounce(i0 + std::size_t(l), depth, s);
+            return;
+        }
+        // Lanes that are not diffuse vertices compute garbage that is never
+        // read; fill them with a copy of a diffuse lane so that nothing traps
+        // or slows down on denormals.
+        const int first = std::countr_zero(diffuse);
+        for (int l = 0; l < K; ++l) {
+            if ((diffuse >> l) & 1u) continue;
+            for (int a = 0; a < 3; ++a) {
+                dir[a][l] = dir[a][first];
+                gn[a][l] = gn[a][first];
+                sn[a][l] = sn[a][first];
+                point[a][l] = point[a][first];
+                albedo[a][l] = albedo[a][first];
+                beta[a][l] = beta[a][first];
+            }
+            total[l] = total[first];
+            wd[l] = wd[first];
+            roulette[l] = roulette[first];
+            u1[l] = u1[first];
+            u2[l] = u2[first];
+        }
+        const auto load3 = [](const float (&v)[3][K]) {
+            return Vec3<F>{F::load_aligned(v[0]), F::load_aligned(v[1]), F::load_aligned(v[2])};
+        };
+        const auto store3 = [](float (&v)[3][K], const Vec3<F>& x) {
+            x.x.store_aligned(v[0]);
+            x.y.store_aligned(v[1]);
+            x.z.store_aligned(v[2]);
+        };
+        // The surface seen from the ray's side (bounce()).
+        const Vec3<F> d = load3(dir);
+        const Vec3<F> wo = -(d / vsqrt(dot(d, d)));
+        const Vec3<F> g = load3(gn), sh = load3(sn);
+        const auto front = dot(wo, g) > F(0.0f);
+        const Vec3<F> ng{select(front, g.x, -g.x), select(front, g.y, -g.y), select(front, g.z, -g.z)};
+        Vec3<F> ns{select(front, sh.x, -sh.x), select(front, sh.y, -sh.y), select(front, sh.z, -sh.z)};
+        const auto bent = dot(ns, ng) < F(0.0f);
+        ns = {select(bent, ng.x, ns.x), select(bent, ng.y, ns.y), select(bent, ng.z, ns.z)};
+        const Vec3<F> above = offset_lanes(offset_, load3(point), ng);
+        alignas(64) float above_l[3][K];
+        store3(above_l, above);
+
+        // Next-event estimation's light per lane (direct_light()): its
+        // kind, and the point to aim at or the direction toward it.
+        enum : int { kNone, kPoint, kDistant, kArea };
+        alignas(64) float target[3][K], light_n[3][K], color[3][K], pdf_area[K];
+        int kind[K];
+        const std::size_t n_point = scene_.lights.size(), n_distant = scene_.distant_lights.size();
+        const std::size_t n_lights = n_point + n_distant + scene_.area_lights.size();
+        const float choose = float(n_lights);
+        for (int l = 0; l < K; ++l) {
+            kind[l] = kNone;
+            for (int a = 0; a < 3; ++a) target[a][l] = light_n[a][l] = color[a][l] = 0.0f;
+            pdf_area[l] = 1.0f;
+            if (!((diffuse >> l) & 1u) || n_lights == 0) continue;
+            const std::size_t i = i0 + std::size_t(l);
+            const Sample2 u = drawn(s, i, 1);
+            const std::size_t pick = std::min(n_lights - 1, std::size_t(u.x * choose));
+            Vec3f t, c;
+            if (pick < n_point) {
+                kind[l] = kPoint;
+                t = scene_.lights[pick].position;
+                c = scene_.lights[pick].color;
+            } else if (pick < n_point + n_distant) {
+                kind[l] = kDistant;
+                t = -scene_.distant_lights[pick - n_point].direction;  // the direction toward it
+                c = scene_.distant_lights[pick - n_point].color;
+            } else {
+                kind[l] = kArea;
+                const std::size_t index = pick - n_point - n_distant;
+                const AreaLight& light = scene_.area_lights[index];
+                const Sample2 v = drawn(s, i, 2);
+                LightSample ls;
+                if (light.shape == AreaLightShape::Parallelogram) {
+                    // sample_area_light's point, with its normal and density computed once.
+                    ls = parallelograms_[index];
+                    ls.point = light.corner + light.edge1 * v.x + light.edge2 * v.y;
+                } else {
+                    ls = sample_area_light(light, {above_l[0][l], above_l[1][l], above_l[2][l]}, v);
+                }
+                t = ls.point;
+                c = light.color;
+                pdf_area[l] = ls.pdf_area;
+                for (int a = 0; a < 3; ++a) light_n[a][l] = ls.normal[a];
+            }
+            for (int a = 0; a < 3; ++a) {
+                target[a][l] = t[a];
+                color[a][l] = c[a];
+            }
+        }
+        alignas(64) float kind_f[K];
+        for (int l = 0; l < K; ++l) kind_f[l] = float(kind[l]);
+        const F kinds = F::load_aligned(kind_f);
+        const auto is_distant = kinds == F(float(kDistant)), is_area = kinds == F(float(kArea));
+        const auto is_point = kinds == F(float(kPoint));
+        // direct_light(): toward a point (a point light or a point on an area
+        // light), or along a distant light's direction.
+        const Vec3<F> tg = load3(target);
+        const Vec3<F> to = tg - above;
+        const F dist2 = dot(to, to);
+        const Vec3<F> toward = to / vsqrt(dist2);
+        const Vec3<F> wi{select(is_distant, tg.x, toward.x), select(is_distant, tg.y, toward.y),
+                         select(is_distant, tg.z, toward.z)};
+        const F cos_s = dot(ns, wi);
+        const F cos_l = -dot(load3(light_n), wi);
+        auto lit = (is_point | is_distant | is_area) & !(cos_s <= F(0.0f)) & !(dot(ng, wi) <= F(0.0f));
+        const auto no_distance = !(dist2 > F(0.0f));
+        lit = lit & !(is_area & (no_distance | (cos_l <= F(0.0f))));
+        const F pdf = F::load_aligned(pdf_area), n_choose(choose);
+        const F pdf_light = pdf * dist2 / cos_l / n_choose;
+        const F bsdf_pdf = cos_s * F(kInvPi);
+        const F mis = pdf_light * pdf_light / (pdf_light * pdf_light + bsdf_pdf * bsdf_pdf);
+        const F scale = select(is_distant, cos_s * n_choose,
+                               select(is_area, cos_s * cos_l / (dist2 * pdf) * n_choose * mis, cos_s / dist2 * n_choose));
+        const F share = F::load_aligned(total) / F::load_aligned(wd);
+        const Vec3<F> alb = load3(albedo), b = load3(beta);
+        const Vec3<F> f{alb.x * F(kInvPi), alb.y * F(kInvPi), alb.z * F(kInvPi)};
+        const Vec3<F> nee_beta{b.x * share, b.y * share, b.z * share};
+        const Vec3<F> c = load3(color);
+        const Vec3<F> contribution{nee_beta.x * f.x * c.x * scale, nee_beta.y * f.y * c.y * scale,
+                                   nee_beta.z * f.z * c.z * scale};
+        alignas(64) float contribution_l[3][K], shadow_dir[3][K];
+        store3(contribution_l, contribution);
+        store3(shadow_dir, Vec3<F>{select(is_distant, tg.x, to.x), select(is_distant, tg.y, to.y),
+                                   select(is_distant, tg.z, to.z)});
+        const std::uint32_t lit_bits = mask_bits(lit);
+
+        // The cosine-weighted bounce: cos and sin per lane, as bounce() calls them.
+        const F r = vsqrt(F::load_aligned(u1));
+        const F phi = F(2.0f * std::numbers::pi_v<float>) * F::load_aligned(u2);
+        alignas(64) float phi_l[K], cos_phi[K], sin_phi[K];
+        phi.store_aligned(phi_l);
+        for (int l = 0; l < K; ++l) {
+            if (!((diffuse >> l) & 1u)) {
+                cos_phi[l] = sin_phi[l] = 0.0f;
+                continue;
+            }
+            cos_phi[l] = std::cos(phi_l[l]);
+            sin_phi[l] = std::sin(phi_l[l]);
+        }
+        const F lx = r * F::load_aligned(cos_phi), ly = r * F::load_aligned(sin_phi);
+        const F lz = vsqrt(std_max(F(0.0f), F(1.0f) - lx * lx - ly * ly));
+        // OrthonormalBasis(ns).to_world({lx, ly, lz}).
+        const F sign = copysign_of(F(1.0f), ns.z);
+        const F a = F(-1.0f) / (sign + ns.z), cc = ns.x * ns.y * a;
+        const Vec3<F> tb{F(1.0f) + sign * ns.x * ns.x * a, sign * cc, -sign * ns.x};
+        const Vec3<F> bb{cc, sign + ns.y * ns.y * a, -ns.y};
+        const Vec3<F> out_dir = tb * lx + bb * ly + ns * lz;
+        const F bounce_pdf = lz * F(kInvPi);
+        Vec3<F> next_beta{b.x * (alb.x * share), b.y * (alb.y * share), b.z * (alb.z * share)};
+        std::uint32_t alive = diffuse;
+        if (depth > path_.rr_depth) {
+            const F q = std_min(F(1.0f), max_component_lanes(next_beta));
+            alive &= mask_bits(F::load_aligned(roulette) < q);
+            next_beta = next_beta / q;
+        }
+        alive &= mask_bits(max_component_lanes(next_beta) > F(0.0f));
+        alignas(64) float out_dir_l[3][K], next_beta_l[3][K], bounce_pdf_l[K];
+        store3(out_dir_l, out_dir);
+        store3(next_beta_l, next_beta);
+        bounce_pdf.store_aligned(bounce_pdf_l);
+
+        // Append in path order, as bounce() would have. Written component
+        // by component from the lane arrays: a Vec3f assembled on the stack
+        // and copied in 8-byte pieces stalls on store forwarding (a tenth of
+        // this function).
+        const auto set = [](Vec3f& v, const float (&lanes)[3][K], int l) {
+            v.x = lanes[0][l];
+            v.y = lanes[1][l];
+            v.z = lanes[2][l];
+        };
+        for (int l = 0; l < n; ++l) {
+            const std::size_t i = i0 + std::size_t(l);
+            if (!((diffuse >> l) & 1u)) {
+                bounce(i, depth, s);
+                continue;
+            }
+            const std::uint32_t si = p.sample[i];
+            if ((lit_bits >> l) & 1u) {
+                ++s.stats.shadow_rays;
+                Rayf& ray = s.shadows.rays.emplace_back();  // spawn_ray / spawn_ray_to
+                set(ray.org, above_l, l);
+                set(ray.dir, shadow_dir, l);
+                ray.tnear = offset_.tnear();
+                ray.tfar = kind[l] == kDistant ? std::numeric_limits<float>::infinity() : kShadowRayEnd;
+                s.shadows.sample.push_back(si);
+                set(s.shadows.contribution.emplace_back(), contribution_l, l);
+            }
+            ++s.stats.diffuse_rays;
+            if (!((alive >> l) & 1u)) continue;
+            // Paths::add(next beta, si, false, bounce pdf, origin) and spawn_ray.
+            Paths& next = s.next;
+            next.bounce_pdf.push_back(bounce_pdf_l[l]);
+            set(next.bounce_origin.emplace_back(), above_l, l);
+            next.hits.emplace_back();
+            set(next.throughput.emplace_back(), next_beta_l, l);
+            next.sample.push_back(si);
+            next.count_emission.push_back(0);
+            Rayf& ray = next.rays.emplace_back();
+            set(ray.org, above_l, l);
+            set(ray.dir, out_dir_l, l);
+            ray.tnear = offset_.tnear();
+            ray.tfar = std::numeric_limits<float>::infinity();
+        }
     }
 
     /// Radiance an area light's surface emits toward `wo`: its colour on

@@ -25,6 +25,10 @@ struct PathOptions {
     int rr_depth = 3;
     /// Hard cap on path vertices after the camera (the eye ray's hit is 1).
     int max_depth = 64;
+    /// Diffuse vertices of static scenes shaded in SIMD lanes (the same bits
+    /// as one by one); false: one by one, the reference the lanes are
+    /// tested against.
+    bool lanes = true;
 };
 
 /// Renders `options.spp` paths per pixel (options.distribution is implied:

@@ -5,20 +5,10 @@
 
 #include "kernels/simd.h"
 #include "render/ray_offset.h"
+#include "render/shade_lanes.h"
 #include "render/shading_points.h"
 
 namespace raypack {
-
-/// The widest lanes this build has.
-#if defined(__AVX512BW__)
-inline constexpr int kShadeLanes = 16;
-#elif defined(__AVX2__)
-inline constexpr int kShadeLanes = 8;
-#elif defined(__SSE4_2__)
-inline constexpr int kShadeLanes = 4;
-#else
-inline constexpr int kShadeLanes = 1;
-#endif
 
 struct PointLightLanes {
     using F = vfloat<kShadeLanes>;

@@ -47,6 +47,7 @@ public:
     RayOffset(OffsetPolicy policy, const Scene& scene);
 
     OffsetPolicy policy() const { return policy_; }
+    float scene_extent() const { return scene_extent_; }
 
     /// The point secondary rays leave from before the offset: robust takes
     /// accurate_hit_point, as the chapter requires (its 256 ULPs cover the

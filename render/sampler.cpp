@@ -4,7 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#if defined(__AVX512F__)
+#if defined(__AVX2__)
 #include <immintrin.h>
 #endif
 
@@ -101,32 +101,100 @@ std::uint32_t owen_scramble(std::uint32_t x, std::uint32_t seed) {
 /// aligned points form a (0, m, 2)-net in base 2.
 std::uint32_t sobol0(std::uint32_t i) { return reverse_bits(i); }
 
-std::uint32_t sobol1(std::uint32_t i) {
-    std::uint32_t x = 0, v = 1u << 31;
-    for (; i; i >>= 1, v ^= v >> 1)
-        if (i & 1) x ^= v;
-    return x;
+/// Its direction numbers are Pascal's triangle mod 2: v_k has bit 31 - j
+/// set iff the bits of j are a subset of those of k (Lucas), so bit 31 - j
+/// of the point is the parity of the set bits k of i with j a subset of k,
+/// a superset sum over GF(2) that five shift-xor steps compute (in place of
+/// a loop over the bits of i). Bit reversed: bit j of the result.
+std::uint32_t sobol1_reversed(std::uint32_t i) {
+    i ^= (i >> 1) & 0x55555555u;
+    i ^= (i >> 2) & 0x33333333u;
+    i ^= (i >> 4) & 0x0F0F0F0Fu;
+    i ^= (i >> 8) & 0x00FF00FFu;
+    return i ^ ((i >> 16) & 0x0000FFFFu);
 }
 
+std::uint32_t sobol1(std::uint32_t i) { return reverse_bits(sobol1_reversed(i)); }
+
+#if defined(__AVX2__)
+// Eight draws in SIMD lanes: their 64-bit hashes in one AVX-512 register,
+// or in two AVX2 registers of four (AVX2 has no 64-bit multiply: it is
+// built from three 32 x 32 -> 64 products). Every function below computes
+// its scalar namesake's bits lane by lane.
 #if defined(__AVX512F__) && defined(__AVX512DQ__) && defined(__AVX512VL__)
 // 64-bit lane operations in their zero-masked forms with a full mask: the
 // same instructions, without the undefined pass-through operand that makes
 // gcc 12 warn (-Wmaybe-uninitialized).
 constexpr __mmask8 kAll8 = 0xFF;
-__m512i srl64(__m512i v, unsigned s) { return _mm512_maskz_srli_epi64(kAll8, v, s); }
-__m512i mul64(__m512i a, __m512i b) { return _mm512_maskz_mullo_epi64(kAll8, a, b); }
-__m512i widen32(__m256i v) { return _mm512_maskz_cvtepu32_epi64(kAll8, v); }
+struct U64x8 {
+    __m512i v;
+    [[gnu::always_inline]] static U64x8 splat(std::uint64_t x) { return {_mm512_set1_epi64(std::int64_t(x))}; }
+    [[gnu::always_inline]] static U64x8 of(const std::uint64_t (&x)[8]) {
+        return {_mm512_setr_epi64(std::int64_t(x[0]), std::int64_t(x[1]), std::int64_t(x[2]), std::int64_t(x[3]),
+                                  std::int64_t(x[4]), std::int64_t(x[5]), std::int64_t(x[6]), std::int64_t(x[7]))};
+    }
+    /// Eight 32-bit lanes zero-extended.
+    [[gnu::always_inline]] static U64x8 widen(__m256i x) { return {_mm512_maskz_cvtepu32_epi64(kAll8, x)}; }
+    [[gnu::always_inline]] friend U64x8 operator^(U64x8 a, U64x8 b) { return {_mm512_xor_si512(a.v, b.v)}; }
+    [[gnu::always_inline]] friend U64x8 operator+(U64x8 a, U64x8 b) { return {_mm512_add_epi64(a.v, b.v)}; }
+    [[gnu::always_inline]] friend U64x8 operator*(U64x8 a, U64x8 b) { return {_mm512_maskz_mullo_epi64(kAll8, a.v, b.v)}; }
+    [[gnu::always_inline]] U64x8 operator>>(unsigned s) const { return {_mm512_maskz_srli_epi64(kAll8, v, s)}; }
+    [[gnu::always_inline]] U64x8 operator<<(unsigned s) const { return {_mm512_maskz_slli_epi64(kAll8, v, s)}; }
+    /// The low 32 bits of each lane.
+    [[gnu::always_inline]] __m256i low32() const { return _mm512_maskz_cvtepi64_epi32(kAll8, v); }
+};
+#else
+struct U64x8 {
+    __m256i lo, hi;  ///< lanes 0-3, 4-7
+    [[gnu::always_inline]] static U64x8 splat(std::uint64_t x) {
+        const __m256i v = _mm256_set1_epi64x(std::int64_t(x));
+        return {v, v};
+    }
+    [[gnu::always_inline]] static U64x8 of(const std::uint64_t (&x)[8]) {
+        return {_mm256_setr_epi64x(std::int64_t(x[0]), std::int64_t(x[1]), std::int64_t(x[2]), std::int64_t(x[3])),
+                _mm256_setr_epi64x(std::int64_t(x[4]), std::int64_t(x[5]), std::int64_t(x[6]), std::int64_t(x[7]))};
+    }
+    [[gnu::always_inline]] static U64x8 widen(__m256i x) {
+        return {_mm256_cvtepu32_epi64(_mm256_castsi256_si128(x)), _mm256_cvtepu32_epi64(_mm256_extracti128_si256(x, 1))};
+    }
+    [[gnu::always_inline]] friend U64x8 operator^(U64x8 a, U64x8 b) { return {_mm256_xor_si256(a.lo, b.lo), _mm256_xor_si256(a.hi, b.hi)}; }
+    [[gnu::always_inline]] friend U64x8 operator+(U64x8 a, U64x8 b) { return {_mm256_add_epi64(a.lo, b.lo), _mm256_add_epi64(a.hi, b.hi)}; }
+    [[gnu::always_inline]] friend U64x8 operator*(U64x8 a, U64x8 b) { return {mul(a.lo, b.lo), mul(a.hi, b.hi)}; }
+    [[gnu::always_inline]] U64x8 operator>>(unsigned s) const {
+        return {_mm256_srli_epi64(lo, int(s)), _mm256_srli_epi64(hi, int(s))};
+    }
+    [[gnu::always_inline]] U64x8 operator<<(unsigned s) const {
+        return {_mm256_slli_epi64(lo, int(s)), _mm256_slli_epi64(hi, int(s))};
+    }
+    [[gnu::always_inline]] __m256i low32() const {
+        // The even 32-bit elements of both halves, in lane order.
+        const __m256 even = _mm256_shuffle_ps(_mm256_castsi256_ps(lo), _mm256_castsi256_ps(hi), _MM_SHUFFLE(2, 0, 2, 0));
+        return _mm256_permute4x64_epi64(_mm256_castps_si256(even), _MM_SHUFFLE(3, 1, 2, 0));
+    }
 
-/// mix() in eight 64-bit lanes.
-__m512i mix8(__m512i h) {
-    h = mul64(_mm512_xor_si512(h, srl64(h, 30)), _mm512_set1_epi64(std::int64_t(0xBF58476D1CE4E5B9ull)));
-    h = mul64(_mm512_xor_si512(h, srl64(h, 27)), _mm512_set1_epi64(std::int64_t(0x94D049BB133111EBull)));
-    return _mm512_xor_si512(h, srl64(h, 31));
+private:
+    /// The low 64 bits of a b: lo lo + (hi lo + lo hi) 2^32.
+    [[gnu::always_inline]] static __m256i mul(__m256i a, __m256i b) {
+        const __m256i cross = _mm256_add_epi64(_mm256_mul_epu32(_mm256_srli_epi64(a, 32), b),
+                                               _mm256_mul_epu32(a, _mm256_srli_epi64(b, 32)));
+        return _mm256_add_epi64(_mm256_mul_epu32(a, b), _mm256_slli_epi64(cross, 32));
+    }
+};
+#endif
+
+/// The high 32 bits of each 64-bit lane.
+[[gnu::always_inline]] inline __m256i high32(const U64x8& v) { return (v >> 32).low32(); }
+
+/// mix() in eight lanes.
+[[gnu::always_inline]] inline U64x8 mix8(U64x8 h) {
+    h = (h ^ (h >> 30)) * U64x8::splat(0xBF58476D1CE4E5B9ull);
+    h = (h ^ (h >> 27)) * U64x8::splat(0x94D049BB133111EBull);
+    return h ^ (h >> 31);
 }
 
 /// permute() in eight 32-bit lanes for a power-of-two n (no cycle walking:
 /// the masked value is already below n).
-__m256i permute8_pow2(__m256i i, std::uint32_t n, __m256i key) {
+[[gnu::always_inline]] inline __m256i permute8_pow2(__m256i i, std::uint32_t n, __m256i key) {
     const __m256i w = _mm256_set1_epi32(int(n - 1));
     auto mul = [](__m256i a, std::uint32_t c) { return _mm256_mullo_epi32(a, _mm256_set1_epi32(int(c))); };
     auto fold = [&](__m256i a, int s) { return _mm256_xor_si256(a, _mm256_srli_epi32(_mm256_and_si256(a, w), s)); };
@@ -151,12 +219,49 @@ __m256i permute8_pow2(__m256i i, std::uint32_t n, __m256i key) {
     return _mm256_and_si256(_mm256_add_epi32(i, key), w);
 }
 
-/// The low 32 bits of each 64-bit lane.
-__m256i low32(__m512i v) { return _mm512_maskz_cvtepi64_epi32(kAll8, v); }
-/// The high 32 bits of each 64-bit lane.
-__m256i high32(__m512i v) { return low32(srl64(v, 32)); }
+/// reverse_bits() in eight lanes: bytes swapped, then each byte's bits
+/// reversed by two nibble lookups.
+[[gnu::always_inline]] inline __m256i reverse_bits8(__m256i x) {
+    const __m256i bswap = _mm256_setr_epi8(3, 2, 1, 0, 7, 6, 5, 4, 11, 10, 9, 8, 15, 14, 13, 12, 3, 2, 1, 0, 7, 6, 5, 4,
+                                           11, 10, 9, 8, 15, 14, 13, 12);
+    // The nibbles 0-15 bit reversed, in the low nibble and in the high one.
+    const __m256i rev_lo = _mm256_setr_epi8(0x0, 0x8, 0x4, 0xC, 0x2, 0xA, 0x6, 0xE, 0x1, 0x9, 0x5, 0xD, 0x3, 0xB, 0x7,
+                                            0xF, 0x0, 0x8, 0x4, 0xC, 0x2, 0xA, 0x6, 0xE, 0x1, 0x9, 0x5, 0xD, 0x3, 0xB,
+                                            0x7, 0xF);
+    const __m256i rev_hi = _mm256_slli_epi16(rev_lo, 4);
+    const __m256i nibble = _mm256_set1_epi8(0x0F);
+    x = _mm256_shuffle_epi8(x, bswap);
+    const __m256i low = _mm256_and_si256(x, nibble), high = _mm256_and_si256(_mm256_srli_epi16(x, 4), nibble);
+    return _mm256_or_si256(_mm256_shuffle_epi8(rev_hi, low), _mm256_shuffle_epi8(rev_lo, high));
+}
+
+/// owen_scramble() in eight lanes, without its two bit reversals: the
+/// scramble of x is reverse_bits8(owen_core8(reverse_bits8(x), seed)).
+[[gnu::always_inline]] inline __m256i owen_core8(__m256i x, __m256i seed) {
+    auto xor_mul = [](__m256i a, std::uint32_t c) {
+        return _mm256_xor_si256(a, _mm256_mullo_epi32(a, _mm256_set1_epi32(int(c))));
+    };
+    x = _mm256_add_epi32(x, seed);
+    x = xor_mul(x, 0x6c50b47cu);
+    x = xor_mul(x, 0xb82f1e52u);
+    x = xor_mul(x, 0xc7afe638u);
+    return xor_mul(x, 0x8d22f6e6u);
+}
+
+/// sobol1() in eight lanes, bit reversed (see sobol1_reversed).
+[[gnu::always_inline]] inline __m256i sobol1_reversed8(__m256i i) {
+    auto step = [](__m256i a, int s, std::uint32_t m) {
+        return _mm256_xor_si256(a, _mm256_and_si256(_mm256_srli_epi32(a, s), _mm256_set1_epi32(int(m))));
+    };
+    i = step(i, 1, 0x55555555u);
+    i = step(i, 2, 0x33333333u);
+    i = step(i, 4, 0x0F0F0F0Fu);
+    i = step(i, 8, 0x00FF00FFu);
+    return step(i, 16, 0x0000FFFFu);
+}
+
 /// unit_float() in eight lanes.
-__m256 unit_float8(__m256i bits) {
+[[gnu::always_inline]] inline __m256 unit_float8(__m256i bits) {
     return _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_srli_epi32(bits, 8)), _mm256_set1_ps(0x1.0p-24f));
 }
 #define RAYPACK_SAMPLER_LANES 1
@@ -208,7 +313,7 @@ void Sampler::get_many(std::span<const Draw> draws, int dimension, Sample2* out)
     std::size_t j = 0;
 #if defined(RAYPACK_SAMPLER_LANES)
     const bool pow2_strata = kind_ == SamplerKind::Stratified && log2_nx_ >= 0 && log2_ny_ >= 0;
-    if (pow2_strata || kind_ == SamplerKind::Random) {
+    if (pow2_strata || kind_ == SamplerKind::Random || kind_ == SamplerKind::Sobol) {
         const auto dim = std::uint64_t(dimension);
         alignas(32) float x[8], y[8];
         for (; j + 8 <= draws.size(); j += 8) {
@@ -216,30 +321,35 @@ void Sampler::get_many(std::span<const Draw> draws, int dimension, Sample2* out)
             // stores then one wide load stall on store forwarding (a sixth
             // of this function's time).
             const Draw* d = &draws[j];
-            const __m512i h = _mm512_setr_epi64(
-                std::int64_t(d[0].pixel.hash), std::int64_t(d[1].pixel.hash), std::int64_t(d[2].pixel.hash),
-                std::int64_t(d[3].pixel.hash), std::int64_t(d[4].pixel.hash), std::int64_t(d[5].pixel.hash),
-                std::int64_t(d[6].pixel.hash), std::int64_t(d[7].pixel.hash));
+            const U64x8 h = U64x8::of({d[0].pixel.hash, d[1].pixel.hash, d[2].pixel.hash, d[3].pixel.hash,
+                                       d[4].pixel.hash, d[5].pixel.hash, d[6].pixel.hash, d[7].pixel.hash});
             const __m256i i = _mm256_setr_epi32(d[0].index, d[1].index, d[2].index, d[3].index, d[4].index,
                                                 d[5].index, d[6].index, d[7].index);
             __m256 fx, fy;
             if (kind_ == SamplerKind::Random) {
                 // hash_keys(pixel hash, dimension, 1 + 4 i)
-                const __m512i purpose = _mm512_add_epi64(_mm512_maskz_slli_epi64(kAll8, widen32(i), 2),
-                                                         _mm512_set1_epi64(std::int64_t(dim * 0x100000001B3ull + 2)));
-                const __m512i r = mix8(_mm512_xor_si512(h, purpose));
-                fx = unit_float8(low32(r));
+                const U64x8 r = mix8(h ^ ((U64x8::widen(i) << 2) + U64x8::splat(dim * 0x100000001B3ull + 2)));
+                fx = unit_float8(r.low32());
                 fy = unit_float8(high32(r));
+            } else if (kind_ == SamplerKind::Sobol) {
+                const U64x8 k1 = mix8(h ^ U64x8::splat(dim * 0x100000001B3ull + 1));
+                const U64x8 k2 = mix8(k1 + U64x8::splat(0x9E3779B97F4A7C15ull));
+                // shuffled = owen_scramble(i, k1); x = owen_scramble(sobol0(shuffled), k1 >> 32)
+                // with sobol0 = reverse_bits, y = owen_scramble(sobol1(shuffled), k2): the
+                // reversals that cancel are left out.
+                const __m256i core = owen_core8(reverse_bits8(i), k1.low32());
+                const __m256i shuffled = reverse_bits8(core);
+                fx = unit_float8(reverse_bits8(owen_core8(shuffled, high32(k1))));
+                fy = unit_float8(reverse_bits8(owen_core8(sobol1_reversed8(shuffled), k2.low32())));
             } else {
-                const __m512i key = mix8(_mm512_xor_si512(h, _mm512_set1_epi64(std::int64_t(dim * 0x100000001B3ull + 1))));
-                const __m256i cell = permute8_pow2(i, std::uint32_t(spp_), low32(key));
-                const __m512i jitter = mix8(_mm512_add_epi64(
-                    key, mul64(_mm512_set1_epi64(std::int64_t(0x9E3779B97F4A7C15ull)),
-                               _mm512_add_epi64(widen32(i), _mm512_set1_epi64(1)))));
+                const U64x8 key = mix8(h ^ U64x8::splat(dim * 0x100000001B3ull + 1));
+                const __m256i cell = permute8_pow2(i, std::uint32_t(spp_), key.low32());
+                const U64x8 jitter =
+                    mix8(key + U64x8::splat(0x9E3779B97F4A7C15ull) * (U64x8::widen(i) + U64x8::splat(1)));
                 const __m256i cx = _mm256_and_si256(cell, _mm256_set1_epi32(grid_.nx - 1));
                 const __m256i cy = _mm256_srlv_epi32(cell, _mm256_set1_epi32(log2_nx_));
                 const __m256 jx = _mm256_mul_ps(
-                    _mm256_cvtepi32_ps(_mm256_srlv_epi32(low32(jitter), _mm256_set1_epi32(8 + log2_nx_))),
+                    _mm256_cvtepi32_ps(_mm256_srlv_epi32(jitter.low32(), _mm256_set1_epi32(8 + log2_nx_))),
                     _mm256_set1_ps(jitter_unit_x_));
                 const __m256 jy = _mm256_mul_ps(
                     _mm256_cvtepi32_ps(_mm256_srlv_epi32(high32(jitter), _mm256_set1_epi32(8 + log2_ny_))),

@@ -63,8 +63,8 @@ public:
     };
     /// out[j] = get(draws[j].pixel, draws[j].index, dimension) for every j,
     /// bit for bit, eight draws at a time in SIMD lanes where the build has
-    /// AVX-512 (the stratified sampler with power-of-two strata, and the
-    /// random one; the others draw one by one).
+    /// AVX2 or AVX-512 (the random and Sobol' samplers, and the stratified
+    /// one with power-of-two strata; the others draw one by one).
     void get_many(std::span<const Draw> draws, int dimension, Sample2* out) const;
 
     /// A point of [0, 1) from a 2D sample: the column of the strata grid

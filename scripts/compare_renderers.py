@@ -27,7 +27,7 @@ def timed(cmd, cwd):
     done = subprocess.run(cmd, cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     elapsed = time.perf_counter() - start
     if done.returncode != 0:
-        sys.exit(f"compare_renderers: {' '.join(cmd)} failed:\n{done.stderr[-2000:]}")
+        sys.exit(f"{os.path.basename(sys.argv[0])}: {' '.join(cmd)} failed:\n{done.stderr[-2000:]}")
     return elapsed
 
 

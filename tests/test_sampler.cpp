@@ -172,9 +172,10 @@ TEST(Sampler, ErrorOrderOnAnEdge) {
 }
 
 TEST(Sampler, ManyDrawsAtOnceAreTheOneByOneDrawsBitForBit) {
-    // get_many runs eight draws in SIMD lanes for the stratified (power-of-
-    // two strata) and random samplers; every kind and grid must give get's
-    // bits, for draws of mixed pixels and indices and a ragged tail.
+    // get_many runs eight draws in SIMD lanes (AVX2 or AVX-512) for the
+    // random, Sobol' and stratified (power-of-two strata) samplers; every
+    // kind and grid must give get's bits, for draws of mixed pixels and
+    // indices and a ragged tail.
     for (const SamplerKind kind :
          {SamplerKind::Regular, SamplerKind::Random, SamplerKind::Stratified, SamplerKind::Sobol}) {
         for (const int spp : {1, 2, 4, 6, 8, 16, 32, 64, 256}) {
