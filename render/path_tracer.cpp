@@ -365,7 +365,11 @@ private:
             u2[l] = u.y;
         }
         if (diffuse == 0) {
-            for (int l = 0; l < n; ++l) bounce(i0 + std::size_t(l), depth, s);
+            for (int l = 0; l < n; ++l) {
+                const std::size_t i = i0 + std::size_t(l);
+                if (p.hits[i].found()) bounce(i, depth, s);
+                else s.radiance[p.sample[i]] += p.throughput[i] * scene_.background;  // bounce()'s miss
+            }
             return;
         }
         // Lanes that are not diffuse vertices compute garbage that is never
@@ -541,7 +545,8 @@ private:
         for (int l = 0; l < n; ++l) {
             const std::size_t i = i0 + std::size_t(l);
             if (!((diffuse >> l) & 1u)) {
-                bounce(i, depth, s);
+                if (p.hits[i].found()) bounce(i, depth, s);
+                else s.radiance[p.sample[i]] += p.throughput[i] * scene_.background;  // bounce()'s miss
                 continue;
             }
             const std::uint32_t si = p.sample[i];

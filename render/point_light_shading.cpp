@@ -3,26 +3,17 @@
 #include <bit>
 #include <cmath>
 
-#include "kernels/simd.h"
+#include "render/light_lanes.h"
 #include "render/ray_offset.h"
-#include "render/shade_lanes.h"
-#include "render/shading_points.h"
 
 namespace raypack {
 
-struct PointLightLanes {
-    using F = vfloat<kShadeLanes>;
-    static constexpr int K = kShadeLanes;
-
-    static Vec3<F> load3(const std::vector<float> (&a)[3], std::size_t j) {
-        return {load_lanes<F>(&a[0][j]), load_lanes<F>(&a[1][j]), load_lanes<F>(&a[2][j])};
-    }
-
+struct PointLightLanes : LightLanes {
     static std::size_t run(const ShadingPoints& pts, const PointLight& light, float intensity,
                            const Attenuation& att, const RayOffset& offset, ShadowQueue& out) {
         const Vec3<F> position{F(light.position.x), F(light.position.y), F(light.position.z)};
         std::size_t emitted = 0;
-        alignas(64) float contribution[3][K], rv_lanes[K], specular[K];
+        alignas(64) float contribution[3][K];
         for (std::size_t j = 0; j < pts.count_; j += K) {
             const std::size_t left = pts.count_ - j;
             const std::uint32_t in_range = left >= std::size_t(K) ? (1u << K) - 1 : (1u << left) - 1;
@@ -39,26 +30,7 @@ struct PointLightLanes {
             const F atten = F(1.0f) / (F(att.c2) * dist * dist + F(att.c1) * dist + F(att.c0));
             const F scale = F(intensity) * atten;
             const Vec3<F> light_color{F(light.color.x) * scale, F(light.color.y) * scale, F(light.color.z) * scale};
-            const F diffuse = load_lanes<F>(&pts.kd_[j]) * ns_l;
-            const Vec3<F> r = ns * (F(2.0f) * ns_l) - l;  // mirror of l about the normal
-            const F minus_rv = -dot(r, view);
-            const F rv = select(F(0.0f) < minus_rv, minus_rv, F(0.0f));  // std::max(0, -dot(r, view))
-            // Phong's powf, per lane, where glibc's result is not +0 anyway.
-            const std::uint32_t shiny = faces & mask_bits(load_lanes<F>(&pts.ks_[j]) > F(0.0f)) &
-                                        mask_bits(rv > load_lanes<F>(&pts.cutoff_[j]));
-            store_lanes(specular, F(0.0f));
-            if (shiny != 0) {
-                store_lanes(rv_lanes, rv);
-                for (std::uint32_t bits = shiny; bits != 0; bits &= bits - 1) {
-                    const int i = std::countr_zero(bits);
-                    specular[i] = pts.ks_[j + std::size_t(i)] * std::pow(rv_lanes[i], pts.shine_[j + std::size_t(i)]);
-                }
-            }
-            const F spec = load_lanes<F>(specular);
-            const Vec3<F> color = load3(pts.color_, j);
-            store_lanes(contribution[0], light_color.x * color.x * diffuse + light_color.x * spec);
-            store_lanes(contribution[1], light_color.y * color.y * diffuse + light_color.y * spec);
-            store_lanes(contribution[2], light_color.z * color.z * diffuse + light_color.z * spec);
+            direct(pts, j, faces, ns, l, ns_l, view, light_color, contribution);
             for (std::uint32_t bits = faces; bits != 0; bits &= bits - 1) {
                 const int i = std::countr_zero(bits);
                 const std::size_t p = j + std::size_t(i);

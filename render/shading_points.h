@@ -3,9 +3,11 @@
 // that the light of a point light reaches many points at once in SIMD
 // lanes (render/point_light_shading.cpp).
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "kernels/ray.h"
+#include "render/sampler.h"
 #include "scene/scene.h"
 
 namespace raypack {
@@ -35,7 +37,9 @@ public:
     Vec3f above(std::size_t j) const { return get(above_, j); }
 
 private:
+    friend struct LightLanes;
     friend struct PointLightLanes;
+    friend struct AreaLightLanes;
     std::size_t count_ = 0;
     std::vector<std::int32_t> ray_;
     std::vector<float> view_[3], ns_[3], ng_[3], above_[3], color_[3];
@@ -73,5 +77,17 @@ struct Attenuation {
 /// same order, and powf runs per lane.
 std::size_t shade_point_light(const ShadingPoints& points, const PointLight& light, float intensity,
                               const Attenuation& attenuation, const RayOffset& offset, ShadowQueue& out);
+
+/// For every point and each of `samples` points on area `light` (point j's
+/// sample k drawn from the unit-square point drawn[j * samples + k]; a
+/// sphere's facing point instead if `facing_point`), appends point by point
+/// and sample by sample a shadow ray toward the light's point and its
+/// Lambert plus Phong light (the light's colour times intensity / samples),
+/// where the point lies on the emitting side and both normals face it.
+/// Returns the number of rays appended. Bit for bit the scalar expressions
+/// (render/area_light_shading.cpp).
+std::size_t shade_area_light(const ShadingPoints& points, const AreaLight& light, std::span<const Sample2> drawn,
+                             int samples, float intensity, bool facing_point, const RayOffset& offset,
+                             ShadowQueue& out);
 
 }  // namespace raypack

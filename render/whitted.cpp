@@ -247,9 +247,25 @@ private:
         for (std::size_t li = 0; li < scene_.lights.size(); ++li)
             stats.shadow_rays +=
                 shade_point_light(s.points, scene_.lights[li], intensity_, attenuation, offset_, s.shadows.per_light[li]);
-        if (!scene_.area_lights.empty()) draw_area_light_samples(depth, s);
-        if (!scene_.distant_lights.empty() || !scene_.area_lights.empty())
-            for (std::size_t j = 0; j < s.points.size(); ++j) shade_other_lights(j, s);
+        if (!scene_.distant_lights.empty())
+            for (std::size_t j = 0; j < s.points.size(); ++j) shade_distant_lights(j, s);
+        if (!scene_.area_lights.empty()) {
+            // The SPD intensity spread evenly over each light's area: the
+            // mean of point lights at stratified points of it, each shining
+            // from the emitting side only.
+            draw_area_light_samples(depth, s);
+            const int n_light = light_samples_.spp();
+            const std::size_t per_light = s.points.size() * std::size_t(n_light);
+            std::size_t bucket = scene_.lights.size() + scene_.distant_lights.size();
+            for (std::size_t a = 0; a < scene_.area_lights.size(); ++a, ++bucket) {
+                const AreaLight& light = scene_.area_lights[a];
+                // Whitted lights a sphere from the point facing the shaded point.
+                const bool facing_point = !options_.distribution && light.shape == AreaLightShape::Sphere;
+                stats.shadow_rays +=
+                    shade_area_light(s.points, light, std::span(s.light_drawn).subspan(a * per_light, per_light),
+                                     n_light, intensity_, facing_point, offset_, s.shadows.per_light[bucket]);
+            }
+        }
         if (depth < options_.max_depth)
             for (std::size_t j = 0; j < s.points.size(); ++j) spawn_children(j, depth, s);
         trace_shadows(s);
@@ -300,9 +316,9 @@ private:
             light_samples_.get_many(s.draws, depth * 64 + int(a % 64), s.light_drawn.data() + a * s.draws.size());
     }
 
-    /// Distant and area lights at shading point j (point lights are done
-    /// for all points at once by shade_point_light).
-    void shade_other_lights(std::size_t j, Scratch& s) const {
+    /// Distant lights at shading point j (point and area lights are done
+    /// for all points at once by shade_point_light and shade_area_light).
+    void shade_distant_lights(std::size_t j, Scratch& s) const {
         const ShadingPoints& pts = s.points;
         const std::int32_t i = pts.ray(j);
         const Material& m = scene_.materials[s.spawn[j].material];
@@ -320,29 +336,6 @@ private:
                 q.contribution.push_back(direct(m, cutoff, light.color * intensity_, ns, l, view));
             }
             ++bucket;
-        }
-        // Area lights: the SPD intensity spread evenly over the light's area,
-        // i.e. the mean of point lights at stratified points of it, each
-        // shining from the emitting side only.
-        const int n_light = light_samples_.spp();
-        for (std::size_t a = 0; a < scene_.area_lights.size(); ++a, ++bucket) {
-            const AreaLight& light = scene_.area_lights[a];
-            const Vec3f share = light.color * (intensity_ / float(n_light));
-            for (int k = 0; k < n_light; ++k) {
-                Sample2 u = s.light_drawn[(a * pts.size() + j) * std::size_t(n_light) + std::size_t(k)];
-                if (!options_.distribution && light.shape == AreaLightShape::Sphere) u = {0, 0};  // the facing point
-                const LightSample ls = sample_area_light(light, above, u);
-                const Vec3f to_light = ls.point - above;
-                const float dist = length(to_light);
-                if (!(dist > 0) || dot(ls.normal, to_light) >= 0) continue;  // behind the emitting side
-                const Vec3f l = to_light / dist;
-                if (dot(ns, l) <= 0 || dot(ng, l) <= 0) continue;
-                ++s.stats.shadow_rays;
-                ShadowQueue& q = s.shadows.per_light[bucket];
-                spawn_ray_to(above, ls.point, offset_, q.rays.emplace_back());
-                q.owner.push_back(i);
-                q.contribution.push_back(direct(m, cutoff, share, ns, l, view));
-            }
         }
     }
 
