@@ -400,15 +400,11 @@ private:
             x.y.store_aligned(v[1]);
             x.z.store_aligned(v[2]);
         };
-        // The surface seen from the ray's side (bounce()).
+        // The surface seen from the ray's side (bounce(): its wo = -view, and
+        // dot(wo, g) > 0 is dot(view, g) < 0 bit for bit).
         const Vec3<F> d = load3(dir);
-        const Vec3<F> wo = -(d / vsqrt(dot(d, d)));
-        const Vec3<F> g = load3(gn), sh = load3(sn);
-        const auto front = dot(wo, g) > F(0.0f);
-        const Vec3<F> ng{select(front, g.x, -g.x), select(front, g.y, -g.y), select(front, g.z, -g.z)};
-        Vec3<F> ns{select(front, sh.x, -sh.x), select(front, sh.y, -sh.y), select(front, sh.z, -sh.z)};
-        const auto bent = dot(ns, ng) < F(0.0f);
-        ns = {select(bent, ng.x, ns.x), select(bent, ng.y, ns.y), select(bent, ng.z, ns.z)};
+        Vec3<F> ng, ns;
+        face_viewer(d / vsqrt(dot(d, d)), load3(gn), load3(sn), ng, ns);
         const Vec3<F> above = offset_lanes(offset_, load3(point), ng);
         alignas(64) float above_l[3][K];
         store3(above_l, above);

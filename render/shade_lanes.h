@@ -36,6 +36,20 @@ RAYPACK_INLINE F max_component_lanes(const Vec3<F>& v) {
     return std_max(std_max(v.x, v.y), v.z);
 }
 
+/// The geometric normal g and shading normal sh of surfaces that rays of
+/// unit direction `view` arrive at, turned toward the viewer (ng, ns; ns
+/// falls back to ng where it is bent past the surface), as the scalar
+/// shading turns them. Returns the lanes that met the outward side.
+template <class F>
+RAYPACK_INLINE auto face_viewer(const Vec3<F>& view, const Vec3<F>& g, const Vec3<F>& sh, Vec3<F>& ng, Vec3<F>& ns) {
+    const auto front = dot(view, g) < F(0.0f);
+    ng = {select(front, g.x, -g.x), select(front, g.y, -g.y), select(front, g.z, -g.z)};
+    ns = {select(front, sh.x, -sh.x), select(front, sh.y, -sh.y), select(front, sh.z, -sh.z)};
+    const auto bent = dot(ns, ng) < F(0.0f);
+    ns = {select(bent, ng.x, ns.x), select(bent, ng.y, ns.y), select(bent, ng.z, ns.z)};
+    return front;
+}
+
 /// RayOffset::offset in lanes, bit for bit, for the Epsilon and Scaled
 /// policies (the robust one moves each coordinate by ULPs: callers keep it
 /// scalar).

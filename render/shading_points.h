@@ -30,6 +30,12 @@ public:
     void add(std::int32_t ray, const Vec3f& view, const Vec3f& ns, const Vec3f& ng, const Vec3f& above,
              const Material& m, float specular_cutoff);
 
+    /// add() for n <= kSpare points at once, their columns given lane by
+    /// lane (arrays of n): the SIMD surface loop's output.
+    void add_many(std::size_t n, const std::int32_t* ray, const float* const view[3], const float* const ns[3],
+                  const float* const ng[3], const float* const above[3], const Material* const* m,
+                  const float* specular_cutoff);
+
     std::int32_t ray(std::size_t j) const { return ray_[j]; }
     Vec3f view(std::size_t j) const { return get(view_, j); }
     Vec3f shading_normal(std::size_t j) const { return get(ns_, j); }

@@ -13,6 +13,7 @@
 #include "render/camera_samples.h"
 #include "render/light_sampling.h"
 #include "render/sampling.h"
+#include "render/shade_lanes.h"
 #include "render/shading_points.h"
 #include "render/surface.h"
 #include "render/thin_lens.h"
@@ -136,9 +137,15 @@ public:
                          options.distribution ? options.light_samples : 1, options.seed ^ 0x5bd1e995ull),
           // Whitted traces every ray at the shutter's opening (one sample,
           // no time); distribution ray tracing samples time per camera sample.
-          timed_(options.distribution && !scene.moving_instances.empty()) {
+          timed_(options.distribution && !scene.moving_instances.empty()),
+          // Surfaces in SIMD lanes need the Epsilon or Scaled offset (the
+          // robust one reads the primitive) and a static scene.
+          lanes_(options.surface_lanes && !timed_ && options.offset != OffsetPolicy::Robust && kShadeLanes > 1) {
         specular_cutoff_.reserve(scene.materials.size());
-        for (const Material& m : scene.materials) specular_cutoff_.push_back(specular_cutoff(m.shine));
+        for (const Material& m : scene.materials) {
+            specular_cutoff_.push_back(specular_cutoff(m.shine));
+            ambient_.push_back(m.color * (intensity_ * m.kd));  // add_point's ambient term
+        }
     }
 
     /// Light buckets: point lights, then distant lights, then area lights.
@@ -210,9 +217,11 @@ private:
     SurfaceTable surfaces_;
     float intensity_ = 1;
     std::vector<float> specular_cutoff_;  ///< per material, see specular_cutoff
+    std::vector<Vec3f> ambient_;          ///< per material, the ambient term
     Sampler samples_;        ///< camera samples: pixel position, lens, glossy lobes
     Sampler light_samples_;  ///< points on area lights
     bool timed_;             ///< rays carry times (RayTree::time)
+    bool lanes_;             ///< hits become shading points in SIMD lanes (add_points_in_lanes)
 
     /// Closest hits of the tree's rays [begin, end), at their times if timed.
     void intersect(int width, std::size_t begin, std::size_t end, RayTree& tree) const {
@@ -231,17 +240,21 @@ private:
         s.points.clear();
         s.spawn.clear();
         RenderStats& stats = s.stats;
-        for (std::size_t i = begin; i < end; ++i) {
-            const Hitf& hit = tree.hits[i];
-            if (depth == 1) {
-                ++stats.eye_rays;
-                stats.eye_hits += hit.found();
+        if (depth == 1) {
+            stats.eye_rays += end - begin;
+            for (std::size_t i = begin; i < end; ++i) stats.eye_hits += tree.hits[i].found();
+        }
+        if (lanes_) {
+            add_points_in_lanes(begin, end, s);
+        } else {
+            for (std::size_t i = begin; i < end; ++i) {
+                const Hitf& hit = tree.hits[i];
+                if (!hit.found()) {
+                    tree.color[i] = scene_.background;
+                    continue;
+                }
+                add_point(std::int32_t(i), tree.rays[i], hit, s);
             }
-            if (!hit.found()) {
-                tree.color[i] = scene_.background;
-                continue;
-            }
-            add_point(std::int32_t(i), tree.rays[i], hit, s);
         }
         const Attenuation attenuation{options_.atten_c0, options_.atten_c1, options_.atten_c2};
         for (std::size_t li = 0; li < scene_.lights.size(); ++li)
@@ -300,6 +313,88 @@ private:
         tree.color[std::size_t(i)] = m.color * (intensity_ * m.kd);  // ambient
         s.points.add(i, view, ns, ng, offset_.offset(p, ng), m, specular_cutoff_[surf.material]);
         s.spawn.push_back({p, surf.material, front});
+    }
+
+    /// add_point for the rays [begin, end), bit for bit, the hits' view
+    /// directions, normals and offset points in SIMD lanes: hits gathered
+    /// K at a time in ray order (so the points keep add_point's order),
+    /// misses and lights' surfaces coloured on the way.
+    void add_points_in_lanes(std::size_t begin, std::size_t end, Scratch& s) const {
+        constexpr int K = kShadeLanes;
+        using F = vfloat<K>;
+        RayTree& tree = s.tree;
+        alignas(64) float dir[3][K], gn[3][K], sn[3][K], point[3][K];
+        alignas(64) float view[3][K], ns_out[3][K], ng_out[3][K], above[3][K], cutoff[K];
+        std::int32_t ray[K];
+        std::uint32_t material[K];
+        const Material* mat[K];
+        int n = 0;
+        const auto flush = [&] {
+            for (int l = n; l < K; ++l)  // unused lanes repeat the first
+                for (int a = 0; a < 3; ++a) {
+                    dir[a][l] = dir[a][0];
+                    gn[a][l] = gn[a][0];
+                    sn[a][l] = sn[a][0];
+                    point[a][l] = point[a][0];
+                }
+            const auto load3 = [](const float (&v)[3][K]) {
+                return Vec3<F>{F::load_aligned(v[0]), F::load_aligned(v[1]), F::load_aligned(v[2])};
+            };
+            const Vec3<F> d = load3(dir);
+            const Vec3<F> v = d / vsqrt(dot(d, d));
+            Vec3<F> ng, ns;
+            const auto front = face_viewer(v, load3(gn), load3(sn), ng, ns);
+            const Vec3<F> up = offset_lanes(offset_, load3(point), ng);
+            for (int a = 0; a < 3; ++a) {
+                v[a].store_aligned(view[a]);
+                ns[a].store_aligned(ns_out[a]);
+                ng[a].store_aligned(ng_out[a]);
+                up[a].store_aligned(above[a]);
+            }
+            const std::uint32_t front_bits = mask_bits(front);
+            const float* const columns[4][3] = {{view[0], view[1], view[2]},
+                                                {ns_out[0], ns_out[1], ns_out[2]},
+                                                {ng_out[0], ng_out[1], ng_out[2]},
+                                                {above[0], above[1], above[2]}};
+            s.points.add_many(std::size_t(n), ray, columns[0], columns[1], columns[2], columns[3], mat, cutoff);
+            for (int l = 0; l < n; ++l) {
+                SpawnPoint& sp = s.spawn.emplace_back();
+                sp.p.x = point[0][l];
+                sp.p.y = point[1][l];
+                sp.p.z = point[2][l];
+                sp.material = material[l];
+                sp.front = (front_bits >> l) & 1u;
+            }
+            n = 0;
+        };
+        for (std::size_t i = begin; i < end; ++i) {
+            const Hitf& hit = tree.hits[i];
+            if (!hit.found()) {
+                tree.color[i] = scene_.background;
+                continue;
+            }
+            const Rayf& r = tree.rays[i];
+            const Surface surf = surfaces_.at(r, hit);
+            const Material& m = scene_.materials[surf.material];
+            if (m.area_light >= 0) {
+                // A light's own surface shows the light's colour.
+                tree.color[i] = scene_.area_lights[std::size_t(m.area_light)].color;
+                continue;
+            }
+            tree.color[i] = ambient_[surf.material];
+            for (int a = 0; a < 3; ++a) {
+                dir[a][n] = r.dir[a];
+                gn[a][n] = surf.geometric_normal[a];
+                sn[a][n] = surf.shading_normal[a];
+                point[a][n] = surf.point[a];
+            }
+            ray[n] = std::int32_t(i);
+            material[n] = surf.material;
+            mat[n] = &m;
+            cutoff[n] = specular_cutoff_[surf.material];
+            if (++n == K) flush();
+        }
+        if (n > 0) flush();
     }
 
     /// The unit-square points of every area light's samples at every

@@ -38,6 +38,9 @@ struct WhittedOptions {
     /// glossy surfaces are mirrors and each area light is one point light
     /// (its centre; a sphere's point facing the shaded point).
     bool distribution = false;
+    /// Hits become shading points in SIMD lanes (the same bits as one by
+    /// one); false: one by one, the reference the lanes are tested against.
+    bool surface_lanes = true;
     int spp = 1;                                   ///< camera samples per pixel
     SamplerKind sampler = SamplerKind::Stratified;
     std::uint64_t seed = 1;
