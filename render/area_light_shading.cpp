@@ -3,6 +3,7 @@
 // expressions the Whitted wavefront used per point.
 #include <bit>
 #include <cmath>
+#include <numbers>
 #include <vector>
 
 #include "render/light_lanes.h"
@@ -56,20 +57,29 @@ struct AreaLightLanes : LightLanes {
                             Vec3<F>{F(light.edge2.x), F(light.edge2.y), F(light.edge2.z)} * y;
                     normal = {F(constant.normal.x), F(constant.normal.y), F(constant.normal.z)};
                 } else {
-                    // A sphere's cap depends on the point: sampled one by one.
-                    alignas(64) float pt[3][K], nm[3][K];
-                    alignas(64) float from[3][K];
-                    for (int a = 0; a < 3; ++a) store_lanes(from[a], above[a]);
+                    // sample_area_light on the cap each point sees, cos and
+                    // sin per lane as it calls them.
+                    const Vec3<F> center{F(light.center.x), F(light.center.y), F(light.center.z)};
+                    const F radius(light.radius);
+                    const Vec3<F> to_point = above - center;
+                    const F d = vsqrt(dot(to_point, to_point));
+                    const F cos_min = select(d > radius, radius / d, F(-1.0f));  // visible_cap_cos
+                    const F x = facing_point ? F(0.0f) : load_lanes<F>(ux);
+                    const F y = facing_point ? F(0.0f) : load_lanes<F>(uy);
+                    const F cos_a = F(1.0f) - x * (F(1.0f) - cos_min);
+                    const F sin_a = vsqrt(std_max(F(0.0f), F(1.0f) - cos_a * cos_a));
+                    alignas(64) float phi[K], cos_phi[K], sin_phi[K];
+                    store_lanes(phi, F(2.0f * std::numbers::pi_v<float>) * y);
                     for (int l = 0; l < K; ++l) {
-                        const Sample2 u = facing_point ? Sample2{0, 0} : Sample2{ux[l], uy[l]};
-                        const LightSample ls = sample_area_light(light, {from[0][l], from[1][l], from[2][l]}, u);
-                        for (int a = 0; a < 3; ++a) {
-                            pt[a][l] = ls.point[a];
-                            nm[a][l] = ls.normal[a];
-                        }
+                        cos_phi[l] = std::cos(phi[l]);
+                        sin_phi[l] = std::sin(phi[l]);
                     }
-                    point = {load_lanes<F>(pt[0]), load_lanes<F>(pt[1]), load_lanes<F>(pt[2])};
-                    normal = {load_lanes<F>(nm[0]), load_lanes<F>(nm[1]), load_lanes<F>(nm[2])};
+                    const auto away = d > F(0.0f);  // not at the centre
+                    const Vec3<F> axis{select(away, to_point.x / d, F(0.0f)),
+                                       select(away, to_point.y / d, F(0.0f)),
+                                       select(away, to_point.z / d, F(1.0f))};
+                    normal = to_world_lanes(axis, sin_a * load_lanes<F>(cos_phi), sin_a * load_lanes<F>(sin_phi), cos_a);
+                    point = center + normal * radius;
                 }
                 const Vec3<F> to_light = point - above;
                 const F dist = vsqrt(dot(to_light, to_light));

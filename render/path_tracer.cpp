@@ -509,12 +509,7 @@ private:
         }
         const F lx = r * F::load_aligned(cos_phi), ly = r * F::load_aligned(sin_phi);
         const F lz = vsqrt(std_max(F(0.0f), F(1.0f) - lx * lx - ly * ly));
-        // OrthonormalBasis(ns).to_world({lx, ly, lz}).
-        const F sign = copysign_of(F(1.0f), ns.z);
-        const F a = F(-1.0f) / (sign + ns.z), cc = ns.x * ns.y * a;
-        const Vec3<F> tb{F(1.0f) + sign * ns.x * ns.x * a, sign * cc, -sign * ns.x};
-        const Vec3<F> bb{cc, sign + ns.y * ns.y * a, -ns.y};
-        const Vec3<F> out_dir = tb * lx + bb * ly + ns * lz;
+        const Vec3<F> out_dir = to_world_lanes(ns, lx, ly, lz);
         const F bounce_pdf = lz * F(kInvPi);
         Vec3<F> next_beta{b.x * (alb.x * share), b.y * (alb.y * share), b.z * (alb.z * share)};
         std::uint32_t alive = diffuse;

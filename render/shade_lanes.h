@@ -50,6 +50,17 @@ RAYPACK_INLINE auto face_viewer(const Vec3<F>& view, const Vec3<F>& g, const Vec
     return front;
 }
 
+/// OrthonormalBasis<float>(n).to_world({lx, ly, lz}) in lanes, bit for bit
+/// (Duff et al. 2017, render/sampling.h).
+template <class F>
+RAYPACK_INLINE Vec3<F> to_world_lanes(const Vec3<F>& n, const F& lx, const F& ly, const F& lz) {
+    const F sign = copysign_of(F(1.0f), n.z);
+    const F a = F(-1.0f) / (sign + n.z), c = n.x * n.y * a;
+    const Vec3<F> t{F(1.0f) + sign * n.x * n.x * a, sign * c, -sign * n.x};
+    const Vec3<F> b{c, sign + n.y * n.y * a, -n.y};
+    return t * lx + b * ly + n * lz;
+}
+
 /// RayOffset::offset in lanes, bit for bit, for the Epsilon and Scaled
 /// policies (the robust one moves each coordinate by ULPs: callers keep it
 /// scalar).
