@@ -53,8 +53,10 @@ bool is_convex(const std::vector<Point2>& p) {
 /// Eberly, "Triangulation by Ear Clipping", Geometric Tools 2002) on a
 /// counter-clockwise loop. A convex corner is an ear when no reflex or flat
 /// vertex lies in or on its triangle; only those can block it in a simple
-/// polygon. Flat corners (collinear or repeated vertices) are cut off as
-/// zero-area triangles, which leaves the remaining region unchanged.
+/// polygon, so they are kept in a list (Eberly's reflex list): clipping an
+/// ear only ever turns a neighbour convex, never reflex. Flat corners
+/// (collinear or repeated vertices) are cut off as zero-area triangles,
+/// which leaves the remaining region unchanged.
 void ear_clip(const std::vector<Point2>& p, Triangles& out) {
     const auto n = std::uint32_t(p.size());
     std::vector<std::uint32_t> prev(n), next(n);
@@ -63,11 +65,29 @@ void ear_clip(const std::vector<Point2>& p, Triangles& out) {
         next[i] = i + 1 == n ? 0 : i + 1;
     }
     auto corner = [&](std::uint32_t i) { return orient(p[prev[i]], p[i], p[next[i]]); };
+    // The vertices whose corner is not convex (reflex or flat), and where
+    // each sits in that list (or -1).
+    std::vector<std::uint32_t> blockers;
+    std::vector<std::int32_t> slot(n, -1);
+    auto update = [&](std::uint32_t i) {
+        const bool blocks = !(corner(i) > 0);
+        if (blocks && slot[i] < 0) {
+            slot[i] = std::int32_t(blockers.size());
+            blockers.push_back(i);
+        } else if (!blocks && slot[i] >= 0) {
+            const std::uint32_t last = blockers.back();
+            blockers[std::size_t(slot[i])] = last;
+            slot[last] = slot[i];
+            blockers.pop_back();
+            slot[i] = -1;
+        }
+    };
+    for (std::uint32_t i = 0; i < n; ++i) update(i);
     auto is_ear = [&](std::uint32_t i) {
         const std::uint32_t a = prev[i], c = next[i];
         if (!(corner(i) > 0)) return false;
-        for (std::uint32_t j = next[c]; j != a; j = next[j]) {
-            if (corner(j) > 0) continue;
+        for (const std::uint32_t j : blockers) {
+            if (j == a || j == c) continue;  // i itself is convex: not listed
             const Point2& q = p[j];
             if (q == p[a] || q == p[i] || q == p[c]) continue;  // a repeated vertex touches, it does not block
             if (orient(p[a], p[i], q) >= 0 && orient(p[i], p[c], q) >= 0 && orient(p[c], p[a], q) >= 0)
@@ -82,6 +102,15 @@ void ear_clip(const std::vector<Point2>& p, Triangles& out) {
             out.push_back({prev[i], i, next[i]});
             next[prev[i]] = next[i];
             prev[next[i]] = prev[i];
+            if (slot[i] >= 0) {  // a flat corner leaves the list
+                const std::uint32_t last = blockers.back();
+                blockers[std::size_t(slot[i])] = last;
+                slot[last] = slot[i];
+                blockers.pop_back();
+                slot[i] = -1;
+            }
+            update(prev[i]);
+            update(next[i]);
             i = prev[i];  // the neighbours' corners changed; look there first
             --remaining;
             misses = 0;
