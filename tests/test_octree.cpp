@@ -136,7 +136,13 @@ void expect_well_formed(const OctreeAccel& accel, const Scene& scene, const Octr
             }
         } else {
             EXPECT_LT(d, oc.max_depth);
-            for (std::uint32_t c = 0; c < 8; ++c) pending.push_back({node.first + c, d + 1});
+            for (std::uint32_t c = 0; c < 8; ++c) {
+                pending.push_back({node.first + c, d + 1});
+                // The packet walk skips the children the node marks empty.
+                ASSERT_LT(std::size_t(node.first) + c, t.nodes.size());
+                const OctreeNode& kid = t.nodes[node.first + c];
+                EXPECT_EQ((node.occupied() >> c) & 1u, kid.is_leaf() && kid.count == 0 ? 0u : 1u) << "child " << c;
+            }
         }
     }
     EXPECT_EQ(std::count(seen.begin(), seen.end(), false), 0);

@@ -114,7 +114,12 @@ void flatten(const BuildNode& b, std::uint32_t index, int depth, Octree& tree) {
     const std::size_t base = tree.nodes.size();
     if (base + 8 >= std::numeric_limits<std::uint32_t>::max()) throw std::length_error("octree: too many nodes");
     tree.nodes.resize(base + 8);
-    tree.nodes[index] = {std::uint32_t(base), OctreeNode::kInner};
+    std::uint32_t occupied = 0;
+    for (int c = 0; c < 8; ++c) {
+        const BuildNode& kid = (*b.kids)[c];
+        if (kid.kids || !kid.refs.empty()) occupied |= 1u << c;
+    }
+    tree.nodes[index] = {std::uint32_t(base), OctreeNode::kInner | occupied};
     for (int c = 0; c < 8; ++c) flatten((*b.kids)[c], std::uint32_t(base + c), depth + 1, tree);
 }
 

@@ -18,14 +18,24 @@ template <class F>
 RAYPACK_INLINE F min3(const F& a, const F& b, const F& c) { return vmin(vmin(a, b), c); }
 
 /// An inner node of the packet walk: each lane's slab parameters, the lanes
-/// that entered it, and the next child to try (mirrored numbering, 8 = done).
+/// that entered it, and the children left to try (mirrored numbering, bit
+/// c: child c; the node's empty children are never tried).
 template <int K>
 struct PacketFrame {
     vfloat<K> t0[3], tm[3], t1[3];
     vmask<K> active;
     std::uint32_t children;
-    int child;
+    std::uint32_t left;
 };
+
+/// `bits` over the children in mirrored numbering: bit c is bit c ^ a of
+/// `bits` (a: the mirroring mask).
+RAYPACK_INLINE std::uint32_t mirrored_children(std::uint32_t bits, unsigned a) {
+    if (a & 1u) bits = ((bits & 0x55u) << 1) | ((bits >> 1) & 0x55u);
+    if (a & 2u) bits = ((bits & 0x33u) << 2) | ((bits >> 2) & 0x33u);
+    if (a & 4u) bits = ((bits & 0x0Fu) << 4) | ((bits >> 4) & 0x0Fu);
+    return bits;
+}
 
 // The lanes of `group` share the mirroring mask `a` (their directions' sign
 // bits). After mirroring every lane runs towards + on every axis, so a lane
@@ -78,16 +88,16 @@ void walk(const Octree& tree, const PacketPrimitiveIntersector<vfloat<K>>& isect
     }
     f->active = active;
     f->children = nodes[0].first;
-    f->child = 0;
+    f->left = mirrored_children(nodes[0].occupied(), a);
     for (;;) {
-        if (f->child >= 8) {
+        if (f->left == 0) {
             if (sp == 0) return;
             f = &stack[--sp];
             continue;
         }
-        const int c = f->child++;
+        const int c = std::countr_zero(f->left);  // ascending: front to back for every lane
+        f->left &= f->left - 1;
         const OctreeNode node = nodes[f->children + (unsigned(c) ^ a)];
-        if (node.count == 0) continue;  // an empty leaf
         const F* c0[3];
         const F* c1[3];
         for (int k = 0; k < 3; ++k) {
@@ -113,7 +123,7 @@ void walk(const Octree& tree, const PacketPrimitiveIntersector<vfloat<K>>& isect
         }
         g->active = m;
         g->children = node.first;
-        g->child = 0;
+        g->left = mirrored_children(node.occupied(), a);
         f = g;
     }
 }
