@@ -101,8 +101,9 @@ std::unique_ptr<OctreeAccel> make_octree(const Scene& scene, const OctreeConfig&
 }
 
 /// Structural invariants: leaves obey leaf_size unless at max depth or
-/// unsplittable, references ascend within leaves and are in range, and the
-/// statistics count what is there.
+/// unsplittable, references ascend within leaves and are in range, inner
+/// nodes mark exactly their empty children, and the statistics count what
+/// is there.
 void expect_well_formed(const OctreeAccel& accel, const Scene& scene, const OctreeConfig& oc) {
     const Octree& t = accel.octree();
     if (t.empty()) return;
