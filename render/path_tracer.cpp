@@ -136,6 +136,8 @@ public:
             q.ws = std::max(0.0f, m.ks);
             q.wt = std::max(0.0f, m.transmittance);
             q.total = q.wd + q.ws + q.wt;
+            q.mirror_weight = (Vec3f{1, 1, 1} * (q.total / q.ws) * m.ks).x;
+            q.mirror = !(m.gloss > 0);
             parts_.push_back(q);
         }
         for (const AreaLight& light : scene.area_lights) parallelograms_.push_back(sample_area_light(light, {}, {}));
@@ -181,6 +183,8 @@ private:
     struct MaterialParts {
         Vec3f albedo;
         float wd, ws, wt, total;
+        float mirror_weight;  ///< a mirror bounce's weight, (total / ws) ks
+        bool mirror;          ///< its specular part is a perfect mirror (no gloss)
     };
     std::vector<MaterialParts> parts_;
     /// Per area light: a parallelogram's normal and density, which
@@ -322,11 +326,12 @@ private:
     }
 
     /// bounce() for the paths [i0, i0 + kShadeLanes), bit for bit: the
-    /// diffuse vertices (the common case) in SIMD lanes, with bounce's
-    /// operations in bounce's order (FMA contraction is off) and cos, sin
-    /// per lane; the others (misses, lights' surfaces, mirrors, glass) one
-    /// by one through bounce(). Rays and shadow rays are appended in path
-    /// order, as bounce() appends them. Needs depth < max_depth.
+    /// diffuse and perfect-mirror vertices (the common cases) in SIMD lanes,
+    /// with bounce's operations in bounce's order (FMA contraction is off)
+    /// and cos, sin per lane; the others (misses, lights' surfaces, glossy
+    /// lobes, glass) one by one through bounce(). Rays and shadow rays are
+    /// appended in path order, as bounce() appends them. Needs depth <
+    /// max_depth.
     void bounce_lanes(std::size_t i0, int depth, Scratch& s) const {
         constexpr int K = kShadeLanes;
         using F = vfloat<K>;
@@ -335,8 +340,8 @@ private:
         // Gathered per lane: the diffuse vertices' ray direction, normals,
         // hit point, albedo and part weights, throughput, draws.
         alignas(64) float dir[3][K], gn[3][K], sn[3][K], point[3][K], albedo[3][K], beta[3][K];
-        alignas(64) float total[K], wd[K], roulette[K], u1[K], u2[K];
-        std::uint32_t diffuse = 0;
+        alignas(64) float total[K], wd[K], mirror_weight[K], roulette[K], u1[K], u2[K];
+        std::uint32_t diffuse = 0, mirror = 0;
         for (int l = 0; l < n; ++l) {
             const std::size_t i = i0 + std::size_t(l);
             const Hitf& hit = p.hits[i];
@@ -346,10 +351,18 @@ private:
             if (scene_.materials[surf.material].area_light >= 0) continue;
             const MaterialParts& q = parts_[surf.material];
             const Sample2 choice = drawn(s, i, 0);
-            if (!(q.total > 0) || !(choice.x * q.total < q.wd)) continue;
-            diffuse |= 1u << l;
+            if (!(q.total > 0)) continue;
+            const float pick = choice.x * q.total;
+            Sample2 u{};
+            if (pick < q.wd) {
+                diffuse |= 1u << l;
+                u = drawn(s, i, 3);
+            } else if (pick < q.wd + q.ws && q.mirror) {
+                mirror |= 1u << l;
+            } else {
+                continue;
+            }
             const Vec3f b = p.throughput[i];
-            const Sample2 u = drawn(s, i, 3);
             for (int a = 0; a < 3; ++a) {
                 dir[a][l] = ray.dir[a];
                 gn[a][l] = surf.geometric_normal[a];
@@ -360,11 +373,13 @@ private:
             }
             total[l] = q.total;
             wd[l] = q.wd;
+            mirror_weight[l] = q.mirror_weight;
             roulette[l] = choice.y;
             u1[l] = u.x;
             u2[l] = u.y;
         }
-        if (diffuse == 0) {
+        const std::uint32_t in_lanes = diffuse | mirror;
+        if (in_lanes == 0) {
             for (int l = 0; l < n; ++l) {
                 const std::size_t i = i0 + std::size_t(l);
                 if (p.hits[i].found()) bounce(i, depth, s);
@@ -372,12 +387,13 @@ private:
             }
             return;
         }
-        // Lanes that are not diffuse vertices compute garbage that is never
-        // read; fill them with a copy of a diffuse lane so that nothing traps
-        // or slows down on denormals.
-        const int first = std::countr_zero(diffuse);
+        // Lanes that are not vertices of the lanes compute garbage that is
+        // never read; fill them with a copy of one that is, so that nothing
+        // traps or slows down on denormals. Mirror lanes' unused draws too.
+        const int first = std::countr_zero(in_lanes);
         for (int l = 0; l < K; ++l) {
-            if ((diffuse >> l) & 1u) continue;
+            if ((mirror >> l) & 1u) u1[l] = u2[l] = 0.0f;
+            if ((in_lanes >> l) & 1u) continue;
             for (int a = 0; a < 3; ++a) {
                 dir[a][l] = dir[a][first];
                 gn[a][l] = gn[a][first];
@@ -388,6 +404,7 @@ private:
             }
             total[l] = total[first];
             wd[l] = wd[first];
+            mirror_weight[l] = mirror_weight[first];
             roulette[l] = roulette[first];
             u1[l] = u1[first];
             u2[l] = u2[first];
@@ -403,8 +420,9 @@ private:
         // The surface seen from the ray's side (bounce(): its wo = -view, and
         // dot(wo, g) > 0 is dot(view, g) < 0 bit for bit).
         const Vec3<F> d = load3(dir);
+        const Vec3<F> view = d / vsqrt(dot(d, d));
         Vec3<F> ng, ns;
-        face_viewer(d / vsqrt(dot(d, d)), load3(gn), load3(sn), ng, ns);
+        face_viewer(view, load3(gn), load3(sn), ng, ns);
         const Vec3<F> above = offset_lanes(offset_, load3(point), ng);
         alignas(64) float above_l[3][K];
         store3(above_l, above);
@@ -509,10 +527,20 @@ private:
         }
         const F lx = r * F::load_aligned(cos_phi), ly = r * F::load_aligned(sin_phi);
         const F lz = vsqrt(std_max(F(0.0f), F(1.0f) - lx * lx - ly * ly));
-        const Vec3<F> out_dir = to_world_lanes(ns, lx, ly, lz);
-        const F bounce_pdf = lz * F(kInvPi);
-        Vec3<F> next_beta{b.x * (alb.x * share), b.y * (alb.y * share), b.z * (alb.z * share)};
-        std::uint32_t alive = diffuse;
+        const Vec3<F> diffuse_dir = to_world_lanes(ns, lx, ly, lz);
+        // The mirror direction of wo = -view about ns, and the mirror's weight.
+        const Vec3<F> wo = -view;
+        const Vec3<F> mirror_dir = ns * (F(2.0f) * dot(wo, ns)) - wo;
+        alignas(64) float mirror_lane[K];
+        for (int l = 0; l < K; ++l) mirror_lane[l] = (mirror >> l) & 1u ? 1.0f : 0.0f;
+        const auto mirrored = F::load_aligned(mirror_lane) > F(0.0f);
+        const Vec3<F> out_dir{select(mirrored, mirror_dir.x, diffuse_dir.x), select(mirrored, mirror_dir.y, diffuse_dir.y),
+                              select(mirrored, mirror_dir.z, diffuse_dir.z)};
+        const F bounce_pdf = select(mirrored, F(0.0f), lz * F(kInvPi));
+        const F w = F::load_aligned(mirror_weight);
+        Vec3<F> next_beta{select(mirrored, b.x * w, b.x * (alb.x * share)), select(mirrored, b.y * w, b.y * (alb.y * share)),
+                          select(mirrored, b.z * w, b.z * (alb.z * share))};
+        std::uint32_t alive = in_lanes;
         if (depth > path_.rr_depth) {
             const F q = std_min(F(1.0f), max_component_lanes(next_beta));
             alive &= mask_bits(F::load_aligned(roulette) < q);
@@ -535,11 +563,12 @@ private:
         };
         for (int l = 0; l < n; ++l) {
             const std::size_t i = i0 + std::size_t(l);
-            if (!((diffuse >> l) & 1u)) {
+            if (!((in_lanes >> l) & 1u)) {
                 if (p.hits[i].found()) bounce(i, depth, s);
                 else s.radiance[p.sample[i]] += p.throughput[i] * scene_.background;  // bounce()'s miss
                 continue;
             }
+            const bool specular = (mirror >> l) & 1u;
             const std::uint32_t si = p.sample[i];
             if ((lit_bits >> l) & 1u) {
                 ++s.stats.shadow_rays;
@@ -551,16 +580,17 @@ private:
                 s.shadows.sample.push_back(si);
                 set(s.shadows.contribution.emplace_back(), contribution_l, l);
             }
-            ++s.stats.diffuse_rays;
+            if (specular) ++s.stats.reflect_rays;
+            else ++s.stats.diffuse_rays;
             if (!((alive >> l) & 1u)) continue;
-            // Paths::add(next beta, si, false, bounce pdf, origin) and spawn_ray.
+            // Paths::add(next beta, si, specular, bounce pdf, origin) and spawn_ray.
             Paths& next = s.next;
             next.bounce_pdf.push_back(bounce_pdf_l[l]);
             set(next.bounce_origin.emplace_back(), above_l, l);
             next.hits.emplace_back();
             set(next.throughput.emplace_back(), next_beta_l, l);
             next.sample.push_back(si);
-            next.count_emission.push_back(0);
+            next.count_emission.push_back(specular);
             Rayf& ray = next.rays.emplace_back();
             set(ray.org, above_l, l);
             set(ray.dir, out_dir_l, l);

@@ -113,6 +113,7 @@ TEST(PathTracer, VerticesInLanesAreTheScalarVerticesBitForBit) {
         << "l 3 -3 5 0.6 0.6 0.5\nld -1 1 -2 0.4 0.4 0.4\nla -1 -1 4  2 0 0  0 2 0  2 2 2\nls 2 2 3 0.3 1 0.8 0.8\n"
         << "f 0.8 0.5 0.3 0.9 0.1 10 0 1\np 4\n-4 -4 0\n4 -4 0\n4 4 0\n-4 4 0\n"   // diffuse floor, a little specular
         << "f 0.9 0.9 0.9 0 1 0 0 1\ns -1 0 1 0.7\n"                              // mirror
+        << "f 0.9 0.7 0.6 0.3 0.6 20 0 1\ns 1.8 -1.2 0.4 0.4\n"                   // diffuse and mirror
         << "gloss 40\nf 0.3 0.8 0.3 0.5 0.5 20 0 1\ns 1 0 1 0.7\ngloss 0\n"       // glossy and diffuse
         << "f 1 1 1 0.1 0.1 10 0.8 1.5\ns 0 -1.5 0.6 0.5\n"                       // glass
         << "f 0.2 0.4 0.9 1 0 0 0 1\np 3\n-3 3 0\n3 3 0\n0 3 3\n";              // diffuse wall
