@@ -65,7 +65,6 @@ inline AccelConfig accel_config(std::string kind, KernelChoice kernels = {}) {
 }
 
 class Accel;
-struct AccelConfig;
 std::unique_ptr<Accel> build_accel(const Scene& scene, const AccelConfig& config);
 
 class Accel {
