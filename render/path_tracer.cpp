@@ -378,13 +378,15 @@ private:
             u1[l] = u.x;
             u2[l] = u.y;
         }
+        // Paths outside the lanes: a miss adds the background in place
+        // (bounce()'s miss), the rest go through bounce().
+        const auto one_by_one = [&](std::size_t i) {
+            if (p.hits[i].found()) bounce(i, depth, s);
+            else s.radiance[p.sample[i]] += p.throughput[i] * scene_.background;
+        };
         const std::uint32_t in_lanes = diffuse | mirror;
         if (in_lanes == 0) {
-            for (int l = 0; l < n; ++l) {
-                const std::size_t i = i0 + std::size_t(l);
-                if (p.hits[i].found()) bounce(i, depth, s);
-                else s.radiance[p.sample[i]] += p.throughput[i] * scene_.background;  // bounce()'s miss
-            }
+            for (int l = 0; l < n; ++l) one_by_one(i0 + std::size_t(l));
             return;
         }
         // Lanes that are not vertices of the lanes compute garbage that is
@@ -564,8 +566,7 @@ private:
         for (int l = 0; l < n; ++l) {
             const std::size_t i = i0 + std::size_t(l);
             if (!((in_lanes >> l) & 1u)) {
-                if (p.hits[i].found()) bounce(i, depth, s);
-                else s.radiance[p.sample[i]] += p.throughput[i] * scene_.background;  // bounce()'s miss
+                one_by_one(i);
                 continue;
             }
             const bool specular = (mirror >> l) & 1u;
