@@ -11,6 +11,7 @@
 #include <bit>
 #include <cstdint>
 #include <limits>
+#include <vector>
 
 #include "kernels/aabb.h"
 
@@ -153,17 +154,34 @@ struct ObjectBins {
     }
 
     void add(const BuildRef* refs, std::size_t n, const BinMap& map) {
-        for (std::size_t i = 0; i < n; ++i) {
-            alignas(16) std::int32_t b[4];
-            _mm_store_si128(reinterpret_cast<__m128i*>(b), map.bin_of(refs[i]));
-            const __m128 lo = refs[i].lo, hi = refs[i].hi;
-            box[0][b[0]].extend(lo, hi);
-            box[1][b[1]].extend(lo, hi);
-            box[2][b[2]].extend(lo, hi);
-            ++count[b[0]][0];
-            ++count[b[1]][1];
-            ++count[b[2]][2];
+        // Neighbouring references often fall in the same bins, and each
+        // update would wait for the last one's store: alternate them
+        // between these bins and a second set, merged at the end (min, max
+        // and integer sums: the same bins).
+        if (n >= std::size_t(4 * bins)) {
+            ObjectBins odd(bins);
+            std::size_t i = 0;
+            for (; i + 1 < n; i += 2) {
+                add_one(refs[i], map);
+                odd.add_one(refs[i + 1], map);
+            }
+            if (i < n) add_one(refs[i], map);
+            merge(odd);
+            return;
         }
+        for (std::size_t i = 0; i < n; ++i) add_one(refs[i], map);
+    }
+
+    void add_one(const BuildRef& ref, const BinMap& map) {
+        alignas(16) std::int32_t b[4];
+        _mm_store_si128(reinterpret_cast<__m128i*>(b), map.bin_of(ref));
+        const __m128 lo = ref.lo, hi = ref.hi;
+        box[0][b[0]].extend(lo, hi);
+        box[1][b[1]].extend(lo, hi);
+        box[2][b[2]].extend(lo, hi);
+        ++count[b[0]][0];
+        ++count[b[1]][1];
+        ++count[b[2]][2];
     }
 
     void merge(const ObjectBins& o) {
@@ -237,21 +255,52 @@ private:
     }
 };
 
-/// Hoare partition of refs[0, n) into the side `is_left` accepts first,
-/// collecting the bounds of both sides on the way. Returns the size of the
-/// left side.
+/// Hoare's partition of refs[0, n) into the side `is_left` accepts first,
+/// collecting the bounds of both sides. Returns the size of the left side.
+///
+/// Hoare's scans swap the k-th reference from the left that belongs right
+/// with the k-th from the right that belongs left, for as long as the two
+/// have not crossed: exactly the k-th of those below the final split with the
+/// k-th of those above it. Done that way, in passes without a branch per
+/// reference (as Edelkamp and Weiss's BlockQuicksort, 2016, does Hoare's
+/// swaps), the references end in Hoare's order; his scans mispredicted about
+/// every other reference of a node that splits evenly.
 template <class IsLeft>
 std::size_t partition_refs(BuildRef* refs, std::size_t n, IsLeft&& is_left, RefBounds& left, RefBounds& right) {
-    std::ptrdiff_t l = 0, r = std::ptrdiff_t(n) - 1;
-    for (;;) {
-        while (l <= r && is_left(refs[l])) left.extend(refs[l++]);
-        while (l <= r && !is_left(refs[r])) right.extend(refs[r--]);
-        if (r < l) break;
-        std::swap(refs[l], refs[r]);
-        left.extend(refs[l++]);
-        right.extend(refs[r--]);
+    constexpr std::size_t kOnStack = 512;
+    std::uint8_t side_on_stack[kOnStack];
+    std::uint32_t out_of_place_on_stack[kOnStack + 1];  // each pass writes one past its last entry
+    std::vector<std::uint8_t> side_on_heap;
+    std::vector<std::uint32_t> out_of_place_on_heap;
+    std::uint8_t* side = side_on_stack;
+    std::uint32_t* out_of_place = out_of_place_on_stack;
+    if (n > kOnStack) {
+        side_on_heap.resize(n);
+        out_of_place_on_heap.resize(n + 1);
+        side = side_on_heap.data();
+        out_of_place = out_of_place_on_heap.data();
     }
-    return std::size_t(l);
+    std::size_t mid = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        side[i] = is_left(refs[i]) ? 1 : 0;
+        mid += side[i];
+    }
+    // Right-side references below mid in increasing order, then left-side
+    // ones from mid up in decreasing order: as many of each.
+    std::size_t below = 0;
+    for (std::size_t i = 0; i < mid; ++i) {
+        out_of_place[below] = std::uint32_t(i);
+        below += side[i] ^ 1u;
+    }
+    std::size_t above = below;
+    for (std::size_t i = n; i-- > mid;) {
+        out_of_place[above] = std::uint32_t(i);
+        above += side[i];
+    }
+    for (std::size_t k = 0; k < below; ++k) std::swap(refs[out_of_place[k]], refs[out_of_place[below + k]]);
+    for (std::size_t i = 0; i < mid; ++i) left.extend(refs[i]);
+    for (std::size_t i = mid; i < n; ++i) right.extend(refs[i]);
+    return mid;
 }
 
 }  // namespace raypack
