@@ -3,12 +3,12 @@
 // expressions the Whitted wavefront used per point.
 #include <bit>
 #include <cmath>
-#include <numbers>
 #include <vector>
 
 #include "render/light_lanes.h"
 #include "render/light_sampling.h"
 #include "render/ray_offset.h"
+#include "render/sin_cos_turns.h"
 
 namespace raypack {
 
@@ -57,8 +57,7 @@ struct AreaLightLanes : LightLanes {
                             Vec3<F>{F(light.edge2.x), F(light.edge2.y), F(light.edge2.z)} * y;
                     normal = {F(constant.normal.x), F(constant.normal.y), F(constant.normal.z)};
                 } else {
-                    // sample_area_light on the cap each point sees, cos and
-                    // sin per lane as it calls them.
+                    // sample_area_light on the cap each point sees.
                     const Vec3<F> center{F(light.center.x), F(light.center.y), F(light.center.z)};
                     const F radius(light.radius);
                     const Vec3<F> to_point = above - center;
@@ -68,17 +67,13 @@ struct AreaLightLanes : LightLanes {
                     const F y = facing_point ? F(0.0f) : load_lanes<F>(uy);
                     const F cos_a = F(1.0f) - x * (F(1.0f) - cos_min);
                     const F sin_a = vsqrt(std_max(F(0.0f), F(1.0f) - cos_a * cos_a));
-                    alignas(64) float phi[K], cos_phi[K], sin_phi[K];
-                    store_lanes(phi, F(2.0f * std::numbers::pi_v<float>) * y);
-                    for (int l = 0; l < K; ++l) {
-                        cos_phi[l] = std::cos(phi[l]);
-                        sin_phi[l] = std::sin(phi[l]);
-                    }
+                    F sin_phi, cos_phi;
+                    sin_cos_turns(y, sin_phi, cos_phi);
                     const auto away = d > F(0.0f);  // not at the centre
                     const Vec3<F> axis{select(away, to_point.x / d, F(0.0f)),
                                        select(away, to_point.y / d, F(0.0f)),
                                        select(away, to_point.z / d, F(1.0f))};
-                    normal = to_world_lanes(axis, sin_a * load_lanes<F>(cos_phi), sin_a * load_lanes<F>(sin_phi), cos_a);
+                    normal = to_world_lanes(axis, sin_a * cos_phi, sin_a * sin_phi, cos_a);
                     point = center + normal * radius;
                 }
                 const Vec3<F> to_light = point - above;

@@ -2,7 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
+
+#include "render/sin_cos_turns.h"
 
 namespace raypack {
 
@@ -36,8 +37,9 @@ Sample2 shaped_filter_offset(PixelFilter filter, Sample2 u) {
         case PixelFilter::Gaussian: {
             // Box-Muller: one 2D point gives a 2D normal point exactly.
             const float r = 0.5f * std::sqrt(-2.0f * std::log(1.0f - u.x));
-            const float phi = 2.0f * std::numbers::pi_v<float> * u.y;
-            return {r * std::cos(phi), r * std::sin(phi)};
+            float sin_phi, cos_phi;
+            sin_cos_turns(u.y, sin_phi, cos_phi);
+            return {r * cos_phi, r * sin_phi};
         }
     }
     return {};

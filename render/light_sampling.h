@@ -8,6 +8,7 @@
 #include "kernels/vec3.h"
 #include "render/sampler.h"
 #include "render/sampling.h"
+#include "render/sin_cos_turns.h"
 #include "scene/scene.h"
 
 namespace raypack {
@@ -53,9 +54,10 @@ inline LightSample sample_area_light(const AreaLight& light, const Vec3f& seen_f
     const float cos_min = visible_cap_cos(d, r);
     const float cos_a = 1.0f - u.x * (1.0f - cos_min);
     const float sin_a = std::sqrt(std::max(0.0f, 1.0f - cos_a * cos_a));
-    const float phi = 2.0f * std::numbers::pi_v<float> * u.y;
+    float sin_phi, cos_phi;
+    sin_cos_turns(u.y, sin_phi, cos_phi);
     const OrthonormalBasis<float> frame(d > 0 ? to_point / d : Vec3f{0, 0, 1});
-    s.normal = frame.to_world({sin_a * std::cos(phi), sin_a * std::sin(phi), cos_a});
+    s.normal = frame.to_world({sin_a * cos_phi, sin_a * sin_phi, cos_a});
     s.point = light.center + s.normal * r;
     s.pdf_area = 1.0f / (2.0f * std::numbers::pi_v<float> * r * r * (1.0f - cos_min));
     return s;

@@ -6,8 +6,11 @@
 #include <cmath>
 #include <cstdint>
 #include <numbers>
+#include <type_traits>
+#include <utility>
 
 #include "kernels/vec3.h"
+#include "render/sin_cos_turns.h"
 
 namespace raypack {
 
@@ -37,12 +40,27 @@ Vec3d uniform_sphere(Generator& g) {
     return {r * std::cos(phi), r * std::sin(phi), z};
 }
 
+/// sin and cos of the azimuth 2 pi u: in float through sin_cos_turns, which
+/// the renderer's SIMD lanes compute bit for bit alike; in double through libm.
+template <class T>
+std::pair<T, T> sin_cos_of_turns(T u) {
+    if constexpr (std::is_same_v<T, float>) {
+        float s, c;
+        sin_cos_turns(u, s, c);
+        return {s, c};
+    } else {
+        const T phi = T(2) * std::numbers::pi_v<T> * u;
+        return {std::sin(phi), std::cos(phi)};
+    }
+}
+
 /// A point of the unit square mapped uniformly onto the unit disk by the polar
 /// map (r = sqrt(u1), phi = 2 pi u2); z is 0.
 template <class T>
 Vec3<T> uniform_disk_polar(T u1, T u2) {
-    const T r = std::sqrt(u1), phi = T(2) * std::numbers::pi_v<T> * u2;
-    return {r * std::cos(phi), r * std::sin(phi), T(0)};
+    const T r = std::sqrt(u1);
+    const auto [sin_phi, cos_phi] = sin_cos_of_turns(u2);
+    return {r * cos_phi, r * sin_phi, T(0)};
 }
 
 /// Malley's method: uniform on the unit disk, lifted to the hemisphere about
@@ -80,8 +98,8 @@ template <class T>
 Vec3<T> phong_lobe(T n, T u1, T u2) {
     const T cos_t = std::pow(u1, T(1) / (n + T(1)));
     const T sin_t = std::sqrt(std::max(T(0), T(1) - cos_t * cos_t));
-    const T phi = T(2) * std::numbers::pi_v<T> * u2;
-    return {sin_t * std::cos(phi), sin_t * std::sin(phi), cos_t};
+    const auto [sin_phi, cos_phi] = sin_cos_of_turns(u2);
+    return {sin_t * cos_phi, sin_t * sin_phi, cos_t};
 }
 
 /// Density of phong_lobe(n, ...) at a direction whose cosine to +z is cos_t.
