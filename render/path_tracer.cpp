@@ -17,6 +17,7 @@
 #include "render/sampler.h"
 #include "render/sampling.h"
 #include "render/shade_lanes.h"
+#include "render/sin_cos_turns.h"
 #include "render/surface.h"
 #include "render/thin_lens.h"
 #include "render/tiles.h"
@@ -127,7 +128,13 @@ public:
           timed_(!scene.moving_instances.empty()),
           // Vertices in SIMD lanes need the Epsilon or Scaled offset (the
           // robust one reads the primitive) and a static scene.
-          lanes_(path.lanes && !timed_ && options.offset != OffsetPolicy::Robust && kShadeLanes > 1) {
+          lanes_(path.lanes && !timed_ && options.offset != OffsetPolicy::Robust && kShadeLanes > 1),
+          // A ray of depth max_depth only gathers emission: area lights'
+          // surfaces, or the background where it misses.
+          spawn_below_(path.skip_dark_rays && scene.area_lights.empty() && scene.background.x == 0 &&
+                               scene.background.y == 0 && scene.background.z == 0
+                           ? path.max_depth - 1
+                           : path.max_depth) {
         parts_.reserve(scene.materials.size());
         for (const Material& m : scene.materials) {
             MaterialParts q;
@@ -178,6 +185,8 @@ private:
     Sampler samples_;
     bool timed_;  ///< the scene moves: every ray at its camera sample's time
     bool lanes_;  ///< diffuse vertices in SIMD lanes (bounce_lanes)
+    /// Vertices of depth below this spawn the next ray (PathOptions::skip_dark_rays).
+    int spawn_below_;
     /// Per material, bounce's weights of its diffuse, specular and
     /// transmitting parts (computed as bounce computes them).
     struct MaterialParts {
@@ -215,6 +224,7 @@ private:
         const int dim = first_dimension(depth);
         for (int d = 0; d < 4; ++d) {
             if (d == 2 && scene_.area_lights.empty()) continue;
+            if (d == 3 && depth >= spawn_below_) continue;
             s.bounce_draws[d].resize(s.bounce_keys.size());
             samples_.get_many(s.bounce_keys, dim + d, s.bounce_draws[d].data());
         }
@@ -270,23 +280,27 @@ private:
         if (!(total > 0)) return;
         const Sample2 choice = drawn(s, i, 0);
         const float pick = choice.x * total;
+        const bool spawn = depth < spawn_below_;
         Vec3f dir;
         Vec3f weight;
         bool specular = true;
         float bounce_pdf = 0;
         Vec3f origin = above;
+        std::uint64_t* counter = &s.stats.reflect_rays;  // the kind of the ray spawned
         if (pick < wd) {
             // Lambertian: next-event estimation, then a cosine-weighted bounce.
             const Vec3f f = albedo * kInvPi;
             direct_light(i, si, above, ns, ng, beta * (total / wd), f, s);
+            if (!spawn) return;
             const Sample2 u = drawn(s, i, 3);
             const Vec3f local = cosine_hemisphere(u.x, u.y);
             dir = OrthonormalBasis<float>(ns).to_world(local);
             bounce_pdf = local.z * kInvPi;
             weight = albedo * (total / wd);  // f cos / pdf = albedo
             specular = false;
-            ++s.stats.diffuse_rays;
+            counter = &s.stats.diffuse_rays;
         } else if (pick < wd + ws) {
+            if (!spawn) return;
             const Vec3f mirror = ns * (2.0f * dot(wo, ns)) - wo;
             dir = mirror;
             if (m.gloss > 0) {
@@ -297,8 +311,8 @@ private:
                 if (dot(dir, ng) <= 0) return;  // absorbed under the surface
             }
             weight = Vec3f{1, 1, 1} * (total / ws) * m.ks;
-            ++s.stats.reflect_rays;
         } else {
+            if (!spawn) return;
             // Dielectric interface without Fresnel (NFF's T is the weight).
             const float eta = front ? 1.0f / m.ior : m.ior;
             const float cos_i = dot(wo, ns);
@@ -307,10 +321,9 @@ private:
             if (k >= 0) {
                 dir = -wo * eta + ns * (eta * cos_i - std::sqrt(k));
                 origin = offset_.offset(hp, -ng);
-                ++s.stats.refract_rays;
+                counter = &s.stats.refract_rays;
             } else {
                 dir = ns * (2.0f * dot(wo, ns)) - wo;  // total internal reflection
-                ++s.stats.reflect_rays;
             }
         }
         Vec3f next_beta = beta * weight;
@@ -322,13 +335,14 @@ private:
             next_beta = next_beta / q;
         }
         if (!(max_component(next_beta) > 0)) return;
+        ++*counter;
         spawn_ray(origin, dir, offset_, s.next.add(next_beta, si, specular, bounce_pdf, origin));
     }
 
     /// bounce() for the paths [i0, i0 + kShadeLanes), bit for bit: the
     /// diffuse and perfect-mirror vertices (the common cases) in SIMD lanes,
-    /// with bounce's operations in bounce's order (FMA contraction is off)
-    /// and cos, sin per lane; the others (misses, lights' surfaces, glossy
+    /// with bounce's operations in bounce's order (FMA contraction is off);
+    /// the others (misses, lights' surfaces, glossy
     /// lobes, glass) one by one through bounce(). Rays and shadow rays are
     /// appended in path order, as bounce() appends them. Needs depth <
     /// max_depth.
@@ -341,7 +355,8 @@ private:
         // hit point, albedo and part weights, throughput, draws.
         alignas(64) float dir[3][K], gn[3][K], sn[3][K], point[3][K], albedo[3][K], beta[3][K];
         alignas(64) float total[K], wd[K], mirror_weight[K], roulette[K], u1[K], u2[K];
-        std::uint32_t diffuse = 0, mirror = 0;
+        std::uint32_t diffuse = 0, mirror = 0, nothing_to_do = 0;
+        const bool spawn = depth < spawn_below_;
         for (int l = 0; l < n; ++l) {
             const std::size_t i = i0 + std::size_t(l);
             const Hitf& hit = p.hits[i];
@@ -356,8 +371,12 @@ private:
             Sample2 u{};
             if (pick < q.wd) {
                 diffuse |= 1u << l;
-                u = drawn(s, i, 3);
+                if (spawn) u = drawn(s, i, 3);
             } else if (pick < q.wd + q.ws && q.mirror) {
+                if (!spawn) {  // a mirror vertex only spawns its ray
+                    nothing_to_do |= 1u << l;
+                    continue;
+                }
                 mirror |= 1u << l;
             } else {
                 continue;
@@ -386,7 +405,8 @@ private:
         };
         const std::uint32_t in_lanes = diffuse | mirror;
         if (in_lanes == 0) {
-            for (int l = 0; l < n; ++l) one_by_one(i0 + std::size_t(l));
+            for (int l = 0; l < n; ++l)
+                if (!((nothing_to_do >> l) & 1u)) one_by_one(i0 + std::size_t(l));
             return;
         }
         // Lanes that are not vertices of the lanes compute garbage that is
@@ -514,45 +534,42 @@ private:
                                    select(is_distant, tg.z, to.z)});
         const std::uint32_t lit_bits = mask_bits(lit);
 
-        // The cosine-weighted bounce: cos and sin per lane, as bounce() calls them.
-        const F r = vsqrt(F::load_aligned(u1));
-        const F phi = F(2.0f * std::numbers::pi_v<float>) * F::load_aligned(u2);
-        alignas(64) float phi_l[K], cos_phi[K], sin_phi[K];
-        phi.store_aligned(phi_l);
-        for (int l = 0; l < K; ++l) {
-            if (!((diffuse >> l) & 1u)) {
-                cos_phi[l] = sin_phi[l] = 0.0f;
-                continue;
-            }
-            cos_phi[l] = std::cos(phi_l[l]);
-            sin_phi[l] = std::sin(phi_l[l]);
-        }
-        const F lx = r * F::load_aligned(cos_phi), ly = r * F::load_aligned(sin_phi);
-        const F lz = vsqrt(std_max(F(0.0f), F(1.0f) - lx * lx - ly * ly));
-        const Vec3<F> diffuse_dir = to_world_lanes(ns, lx, ly, lz);
-        // The mirror direction of wo = -view about ns, and the mirror's weight.
-        const Vec3<F> wo = -view;
-        const Vec3<F> mirror_dir = ns * (F(2.0f) * dot(wo, ns)) - wo;
-        alignas(64) float mirror_lane[K];
-        for (int l = 0; l < K; ++l) mirror_lane[l] = (mirror >> l) & 1u ? 1.0f : 0.0f;
-        const auto mirrored = F::load_aligned(mirror_lane) > F(0.0f);
-        const Vec3<F> out_dir{select(mirrored, mirror_dir.x, diffuse_dir.x), select(mirrored, mirror_dir.y, diffuse_dir.y),
-                              select(mirrored, mirror_dir.z, diffuse_dir.z)};
-        const F bounce_pdf = select(mirrored, F(0.0f), lz * F(kInvPi));
-        const F w = F::load_aligned(mirror_weight);
-        Vec3<F> next_beta{select(mirrored, b.x * w, b.x * (alb.x * share)), select(mirrored, b.y * w, b.y * (alb.y * share)),
-                          select(mirrored, b.z * w, b.z * (alb.z * share))};
-        std::uint32_t alive = in_lanes;
-        if (depth > path_.rr_depth) {
-            const F q = std_min(F(1.0f), max_component_lanes(next_beta));
-            alive &= mask_bits(F::load_aligned(roulette) < q);
-            next_beta = next_beta / q;
-        }
-        alive &= mask_bits(max_component_lanes(next_beta) > F(0.0f));
+        // The next rays (none where no ray could carry light back).
         alignas(64) float out_dir_l[3][K], next_beta_l[3][K], bounce_pdf_l[K];
-        store3(out_dir_l, out_dir);
-        store3(next_beta_l, next_beta);
-        bounce_pdf.store_aligned(bounce_pdf_l);
+        std::uint32_t alive = 0;
+        if (spawn) {
+            // The cosine-weighted bounce, as bounce()'s cosine_hemisphere.
+            const F r = vsqrt(F::load_aligned(u1));
+            F sin_phi, cos_phi;
+            sin_cos_turns(F::load_aligned(u2), sin_phi, cos_phi);
+            const F lx = r * cos_phi, ly = r * sin_phi;
+            const F lz = vsqrt(std_max(F(0.0f), F(1.0f) - lx * lx - ly * ly));
+            const Vec3<F> diffuse_dir = to_world_lanes(ns, lx, ly, lz);
+            // The mirror direction of wo = -view about ns, and the mirror's weight.
+            const Vec3<F> wo = -view;
+            const Vec3<F> mirror_dir = ns * (F(2.0f) * dot(wo, ns)) - wo;
+            alignas(64) float mirror_lane[K];
+            for (int l = 0; l < K; ++l) mirror_lane[l] = (mirror >> l) & 1u ? 1.0f : 0.0f;
+            const auto mirrored = F::load_aligned(mirror_lane) > F(0.0f);
+            const Vec3<F> out_dir{select(mirrored, mirror_dir.x, diffuse_dir.x),
+                                  select(mirrored, mirror_dir.y, diffuse_dir.y),
+                                  select(mirrored, mirror_dir.z, diffuse_dir.z)};
+            const F bounce_pdf = select(mirrored, F(0.0f), lz * F(kInvPi));
+            const F w = F::load_aligned(mirror_weight);
+            Vec3<F> next_beta{select(mirrored, b.x * w, b.x * (alb.x * share)),
+                              select(mirrored, b.y * w, b.y * (alb.y * share)),
+                              select(mirrored, b.z * w, b.z * (alb.z * share))};
+            alive = in_lanes;
+            if (depth > path_.rr_depth) {
+                const F q = std_min(F(1.0f), max_component_lanes(next_beta));
+                alive &= mask_bits(F::load_aligned(roulette) < q);
+                next_beta = next_beta / q;
+            }
+            alive &= mask_bits(max_component_lanes(next_beta) > F(0.0f));
+            store3(out_dir_l, out_dir);
+            store3(next_beta_l, next_beta);
+            bounce_pdf.store_aligned(bounce_pdf_l);
+        }
 
         // Append in path order, as bounce() would have. Written component
         // by component from the lane arrays: a Vec3f assembled on the stack
@@ -566,7 +583,7 @@ private:
         for (int l = 0; l < n; ++l) {
             const std::size_t i = i0 + std::size_t(l);
             if (!((in_lanes >> l) & 1u)) {
-                one_by_one(i);
+                if (!((nothing_to_do >> l) & 1u)) one_by_one(i);
                 continue;
             }
             const bool specular = (mirror >> l) & 1u;
@@ -581,9 +598,9 @@ private:
                 s.shadows.sample.push_back(si);
                 set(s.shadows.contribution.emplace_back(), contribution_l, l);
             }
+            if (!((alive >> l) & 1u)) continue;
             if (specular) ++s.stats.reflect_rays;
             else ++s.stats.diffuse_rays;
-            if (!((alive >> l) & 1u)) continue;
             // Paths::add(next beta, si, specular, bounce pdf, origin) and spawn_ray.
             Paths& next = s.next;
             next.bounce_pdf.push_back(bounce_pdf_l[l]);

@@ -29,6 +29,12 @@ struct PathOptions {
     /// as one by one); false: one by one, the reference the lanes are
     /// tested against.
     bool lanes = true;
+    /// Rays that could carry no light are not traced: with no area light
+    /// and a black background, a ray from the last vertex that may light
+    /// its path (max_depth - 1) can only find a surface whose lighting is
+    /// never computed, so it is not spawned (the image is the same bit for
+    /// bit). false: traced anyway, the reference this is tested against.
+    bool skip_dark_rays = true;
 };
 
 /// Renders `options.spp` paths per pixel (options.distribution is implied:

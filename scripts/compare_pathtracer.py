@@ -6,7 +6,12 @@ alternating the two programs round by round; prints both medians, the
 ratio of the medians and the median of the rounds' own ratios
 (docs/renderer.md, "Path tracing against Embree's path tracer").
 
-usage: scripts/compare_pathtracer.py [--rounds N] [--spp 16] [--depth 4]
+Path length L is Embree's --max-path-length L: at most L closest-hit rays
+per path and a shadow ray at each of their L hits. raypack's --depth counts
+rays, and its last ray only gathers emission (none here: no area light, a
+black background, so it is not traced), so the same work is --depth L + 1.
+
+usage: scripts/compare_pathtracer.py [--rounds N] [--spp 16] [--path-length 4]
                                      [--raypack BUILD/raypack] [--obj scenes/bunny.obj]
 """
 import argparse
@@ -31,7 +36,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--rounds", type=int, default=7)
     ap.add_argument("--spp", type=int, default=16)
-    ap.add_argument("--depth", type=int, default=4)
+    ap.add_argument("--path-length", type=int, default=4)
     ap.add_argument("--raypack", default=os.path.join(ROOT, "build", "raypack"))
     ap.add_argument("--obj", default=os.path.join(ROOT, "scenes", "bunny.obj"))
     args = ap.parse_args()
@@ -43,10 +48,11 @@ def main():
     nff = os.path.join(work, "bunny_pt.nff")
     with open(nff, "w") as f:
         f.write(BUNNY_NFF.format(obj=os.path.abspath(args.obj)))
-    ours = [raypack, "render", nff, "--integrator", "path", "--spp", str(args.spp), "--depth", str(args.depth),
+    ours = [raypack, "render", nff, "--integrator", "path", "--spp", str(args.spp),
+            "--depth", str(args.path_length + 1),
             "--threads", "1", "-o", os.path.join(work, "raypack.png")]
     theirs = [embree, "-i", os.path.abspath(args.obj), "--size", "512", "512", "--spp", str(args.spp),
-              "--max-path-length", str(args.depth), "--threads", "1", "--directionallight", "-1", "-1", "-1", "3",
+              "--max-path-length", str(args.path_length), "--threads", "1", "--directionallight", "-1", "-1", "-1", "3",
               "3", "3", *EMBREE_CAMERA, "-o", os.path.join(work, "embree.tga")]
     times = {"raypack": [], "embree": []}
     for _ in range(args.rounds):
@@ -55,7 +61,7 @@ def main():
     shutil.rmtree(work, ignore_errors=True)
     med = {k: statistics.median(v) for k, v in times.items()}
     per_round = statistics.median(e / r for e, r in zip(times["embree"], times["raypack"]))
-    print(f"# bunny, 512 x 512, {args.spp} spp, path length {args.depth}, 1 thread, {args.rounds} alternating "
+    print(f"# bunny, 512 x 512, {args.spp} spp, path length {args.path_length}, 1 thread, {args.rounds} alternating "
           f"rounds, whole-process seconds; processor: {cpu_name()}")
     print("| Embree pathtracer | raypack | Embree / raypack (medians) | median of the rounds' ratios |")
     print("|---|---|---|---|")

@@ -36,7 +36,7 @@ CASES = [
     ("cornell", "gen:cornell:1", ["--integrator", "distribution", "--spp", "4"]),
     ("cornell", "gen:cornell:2", ["--integrator", "path", "--spp", "4", "--depth", "4"]),
     ("balls", "scenes/balls.nff", ["--integrator", "path", "--spp", "4", "--depth", "4"]),
-    ("bunny (docs/renderer.md)", "BUNNY", ["--integrator", "path", "--spp", "16", "--depth", "4"]),
+    ("bunny (docs/renderer.md)", "BUNNY", ["--integrator", "path", "--spp", "16", "--depth", "5"]),
 ]
 
 # The path-tracing anchor of docs/renderer.md: Embree's pathtracer's view of

@@ -6,6 +6,7 @@
 
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <sstream>
@@ -19,6 +20,41 @@
 
 namespace raypack {
 namespace {
+
+/// A sampled render of size x size pixels at spp samples per pixel.
+WhittedOptions sampled(int size, int spp) {
+    WhittedOptions o;
+    o.width = o.height = size;
+    o.distribution = true;
+    o.spp = spp;
+    return o;
+}
+
+/// One render with a PathOptions switch on and one with it off.
+struct OnAndOff {
+    RenderStats on, off;
+    Image on_image, off_image;
+    /// Pixel channels whose bits differ between the two images.
+    std::size_t differing() const {
+        EXPECT_EQ(on_image.rgb.size(), off_image.rgb.size());
+        std::size_t differ = 0;
+        for (std::size_t i = 0; i < std::min(on_image.rgb.size(), off_image.rgb.size()); ++i)
+            differ += std::bit_cast<std::uint32_t>(on_image.rgb[i]) != std::bit_cast<std::uint32_t>(off_image.rgb[i]);
+        return differ;
+    }
+};
+
+OnAndOff render_on_and_off(const Scene& s, const Accel& accel, const WhittedOptions& o, PathOptions path,
+                           bool PathOptions::*option) {
+    OnAndOff r;
+    path.*option = true;
+    r.on = render_path(s, accel, o, path, r.on_image);
+    path.*option = false;
+    r.off = render_path(s, accel, o, path, r.off_image);
+    return r;
+}
+
+std::uint64_t bounce_rays(const RenderStats& r) { return r.diffuse_rays + r.reflect_rays + r.refract_rays; }
 
 /// The unit cube, each face a parallelogram light facing inward, of
 /// albedo `a`; the camera at its centre.
@@ -39,10 +75,7 @@ struct Estimate {
 
 Estimate render_furnace(const Scene& s, int rr_depth, int max_depth, int spp, std::uint64_t seed) {
     const auto accel = build_accel(s, AccelConfig{});
-    WhittedOptions o;
-    o.width = o.height = 8;
-    o.distribution = true;
-    o.spp = spp;
+    WhittedOptions o = sampled(8, spp);
     o.seed = seed;
     o.sampler = SamplerKind::Random;
     PathOptions path;
@@ -84,10 +117,7 @@ TEST(PathTracer, FurnaceConvergesToEmissionOverOneMinusAlbedo) {
 TEST(PathTracer, SameImageForAnyThreadCount) {
     const Scene s = load_scene("gen:cornell:2");
     const auto accel = build_accel(s, AccelConfig{});
-    WhittedOptions o;
-    o.width = o.height = 40;
-    o.distribution = true;
-    o.spp = 4;
+    WhittedOptions o = sampled(40, 4);
     o.sampler = SamplerKind::Sobol;
     Image one, two;
     {
@@ -124,19 +154,14 @@ TEST(PathTracer, VerticesInLanesAreTheScalarVerticesBitForBit) {
     // ulp of one shadow ray's contribution is not lost in a sum.
     for (const auto& [sampler, spp] : {std::pair{SamplerKind::Random, 1}, std::pair{SamplerKind::Sobol, 8}}) {
         for (const OffsetPolicy offset : {OffsetPolicy::Scaled, OffsetPolicy::Epsilon}) {
-            WhittedOptions o;
-            o.width = o.height = spp == 1 ? 64 : 24;
-            o.distribution = true;
-            o.spp = spp;
+            WhittedOptions o = sampled(spp == 1 ? 64 : 24, spp);
             o.sampler = sampler;
             o.offset = offset;
             PathOptions path;
             path.rr_depth = 1;
             path.max_depth = 6;
-            Image lanes, scalar;
-            const RenderStats a = render_path(s, *accel, o, path, lanes);
-            path.lanes = false;
-            const RenderStats b = render_path(s, *accel, o, path, scalar);
+            const OnAndOff r = render_on_and_off(s, *accel, o, path, &PathOptions::lanes);
+            const RenderStats &a = r.on, &b = r.off;
             EXPECT_GT(a.diffuse_rays, 1000u);
             EXPECT_GT(a.reflect_rays, 100u);
             EXPECT_GT(a.refract_rays, 100u);
@@ -144,13 +169,53 @@ TEST(PathTracer, VerticesInLanesAreTheScalarVerticesBitForBit) {
             EXPECT_EQ(a.shadow_rays, b.shadow_rays);
             EXPECT_EQ(a.reflect_rays, b.reflect_rays);
             EXPECT_EQ(a.refract_rays, b.refract_rays);
-            ASSERT_EQ(lanes.rgb.size(), scalar.rgb.size());
-            std::size_t differ = 0;
-            for (std::size_t i = 0; i < lanes.rgb.size(); ++i)
-                differ += std::bit_cast<std::uint32_t>(lanes.rgb[i]) != std::bit_cast<std::uint32_t>(scalar.rgb[i]);
-            EXPECT_EQ(differ, 0u) << sampler_name(sampler) << " spp " << spp << " " << offset_policy_name(offset);
+            EXPECT_EQ(r.differing(), 0u) << sampler_name(sampler) << " spp " << spp << " " << offset_policy_name(offset);
         }
     }
+}
+
+TEST(PathTracer, RaysThatCannotCarryLightAreNotTracedAndTheImageStays) {
+    // No area light and a black background: a ray of the last depth could
+    // only find a surface whose lighting is never computed. Without it
+    // (PathOptions::skip_dark_rays) the image is the same bit for bit, in
+    // lanes and one by one, the shadow rays are the same, and the bounce
+    // rays fewer; at depth 2 no bounce ray is left at all.
+    std::ostringstream nff;
+    nff << "v\nfrom 0 -6 2\nat 0 0 0.5\nup 0 0 1\nangle 50\nhither 0\nresolution 32 32\n"
+        << "b 0 0 0\nl 3 -3 5 0.6 0.6 0.5\nld -1 1 -2 0.4 0.4 0.4\n"
+        << "f 0.8 0.5 0.3 0.9 0.1 10 0 1\np 4\n-4 -4 0\n4 -4 0\n4 4 0\n-4 4 0\n"  // diffuse floor
+        << "f 0.9 0.9 0.9 0 1 0 0 1\ns -1 0 1 0.7\n"                             // mirror
+        << "gloss 40\nf 0.3 0.8 0.3 0.5 0.5 20 0 1\ns 1 0 1 0.7\ngloss 0\n"      // glossy and diffuse
+        << "f 1 1 1 0.1 0.1 10 0.8 1.5\ns 0 -1.5 0.6 0.5\n";                     // glass
+    std::istringstream in(nff.str());
+    const Scene s = load_nff(in, "dark");
+    const auto accel = build_accel(s, AccelConfig{});
+    for (const int depth : {2, 3}) {
+        for (const bool lanes : {true, false}) {
+            const WhittedOptions o = sampled(32, 4);
+            PathOptions path;
+            path.rr_depth = 1;  // roulette where the rays are skipped too
+            path.max_depth = depth;
+            path.lanes = lanes;
+            const OnAndOff r = render_on_and_off(s, *accel, o, path, &PathOptions::skip_dark_rays);
+            EXPECT_EQ(r.on.eye_rays, r.off.eye_rays);
+            EXPECT_EQ(r.on.shadow_rays, r.off.shadow_rays);
+            EXPECT_GT(r.on.shadow_rays, 1000u);
+            if (depth == 2) EXPECT_EQ(bounce_rays(r.on), 0u);
+            else EXPECT_GT(bounce_rays(r.on), 1000u);
+            EXPECT_GT(bounce_rays(r.off), bounce_rays(r.on) + 100) << depth;
+            EXPECT_EQ(r.differing(), 0u) << "depth " << depth << (lanes ? " lanes" : " one by one");
+        }
+    }
+    // Under a sky every ray may find light: all of them are traced.
+    Scene sky = s;
+    sky.background = {0.1f, 0.2f, 0.3f};
+    const WhittedOptions o = sampled(16, 2);
+    PathOptions path;
+    path.max_depth = 3;
+    const OnAndOff r = render_on_and_off(sky, *accel, o, path, &PathOptions::skip_dark_rays);
+    EXPECT_GT(r.on.diffuse_rays, 100u);
+    EXPECT_EQ(bounce_rays(r.on), bounce_rays(r.off));
 }
 
 }  // namespace
