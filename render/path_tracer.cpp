@@ -7,6 +7,7 @@
 #include <limits>
 #include <memory>
 #include <numbers>
+#include <span>
 #include <vector>
 
 #include "render/camera_rays.h"
@@ -107,6 +108,7 @@ struct Scratch {
     /// at the path's draw_of entry.
     std::vector<SampleKey> bounce_keys;
     std::vector<std::int32_t> draw_of;
+    std::vector<std::uint32_t> found;  ///< the level's paths that found a surface (draw_bounce)
     std::vector<Sample2> bounce_draws[4];
     std::vector<Vec3f> radiance;      ///< per sample of the tile
     std::vector<float> times;         ///< moving scenes: per ray of a query, its sample's time
@@ -129,12 +131,11 @@ public:
           // Vertices in SIMD lanes need the Epsilon or Scaled offset (the
           // robust one reads the primitive) and a static scene.
           lanes_(path.lanes && !timed_ && options.offset != OffsetPolicy::Robust && kShadeLanes > 1),
+          black_background_(scene.background.x == 0 && scene.background.y == 0 && scene.background.z == 0),
           // A ray of depth max_depth only gathers emission: area lights'
           // surfaces, or the background where it misses.
-          spawn_below_(path.skip_dark_rays && scene.area_lights.empty() && scene.background.x == 0 &&
-                               scene.background.y == 0 && scene.background.z == 0
-                           ? path.max_depth - 1
-                           : path.max_depth) {
+          spawn_below_(path.skip_dark_rays && scene.area_lights.empty() && black_background_ ? path.max_depth - 1
+                                                                                            : path.max_depth) {
         parts_.reserve(scene.materials.size());
         for (const Material& m : scene.materials) {
             MaterialParts q;
@@ -166,9 +167,18 @@ public:
             s.next.clear();
             s.shadows.clear();
             if (depth < path_.max_depth) draw_bounce(depth, s);
-            if (lanes_ && depth < path_.max_depth)
-                for (std::size_t i = 0; i < p.rays.size(); i += kShadeLanes) bounce_lanes(i, depth, s);
-            else
+            if (lanes_ && depth < path_.max_depth) {
+                // The paths that found a surface (draw_bounce's list) fill
+                // the lanes: a bunny's camera rays hit in 3 of 10 lanes. A
+                // miss only adds the background, as bounce() does.
+                if (!black_background_)
+                    for (std::size_t i = 0; i < p.rays.size(); ++i)
+                        if (!p.hits[i].found()) s.radiance[p.sample[i]] += p.throughput[i] * scene_.background;
+                for (std::size_t k = 0; k < s.found.size(); k += kShadeLanes)
+                    bounce_lanes(std::span<const std::uint32_t>(s.found).subspan(
+                                     k, std::min<std::size_t>(kShadeLanes, s.found.size() - k)),
+                                 depth, s);
+            } else
                 for (std::size_t i = 0; i < p.rays.size(); ++i) bounce(i, depth, s);
             trace_shadows(s);
             std::swap(s.paths, s.next);
@@ -185,6 +195,7 @@ private:
     Sampler samples_;
     bool timed_;  ///< the scene moves: every ray at its camera sample's time
     bool lanes_;  ///< diffuse vertices in SIMD lanes (bounce_lanes)
+    bool black_background_;  ///< a miss adds nothing
     /// Vertices of depth below this spawn the next ray (PathOptions::skip_dark_rays).
     int spawn_below_;
     /// Per material, bounce's weights of its diffuse, specular and
@@ -216,10 +227,14 @@ private:
     void draw_bounce(int depth, Scratch& s) const {
         const Paths& p = s.paths;
         s.bounce_keys.clear();
+        s.found.clear();
         s.draw_of.resize(p.rays.size());
         for (std::size_t i = 0; i < p.rays.size(); ++i) {
             s.draw_of[i] = p.hits[i].found() ? std::int32_t(s.bounce_keys.size()) : -1;
-            if (p.hits[i].found()) s.bounce_keys.push_back(s.camera.keys[p.sample[i]]);
+            if (p.hits[i].found()) {
+                s.bounce_keys.push_back(s.camera.keys[p.sample[i]]);
+                s.found.push_back(std::uint32_t(i));
+            }
         }
         const int dim = first_dimension(depth);
         for (int d = 0; d < 4; ++d) {
@@ -339,18 +354,19 @@ private:
         spawn_ray(origin, dir, offset_, s.next.add(next_beta, si, specular, bounce_pdf, origin));
     }
 
-    /// bounce() for the paths [i0, i0 + kShadeLanes), bit for bit: the
+    /// bounce() for the paths `paths` (at most kShadeLanes, each of which
+    /// found a surface), bit for bit: the
     /// diffuse and perfect-mirror vertices (the common cases) in SIMD lanes,
     /// with bounce's operations in bounce's order (FMA contraction is off);
     /// the others (misses, lights' surfaces, glossy
     /// lobes, glass) one by one through bounce(). Rays and shadow rays are
     /// appended in path order, as bounce() appends them. Needs depth <
     /// max_depth.
-    void bounce_lanes(std::size_t i0, int depth, Scratch& s) const {
+    void bounce_lanes(std::span<const std::uint32_t> paths, int depth, Scratch& s) const {
         constexpr int K = kShadeLanes;
         using F = vfloat<K>;
         const Paths& p = s.paths;
-        const int n = int(std::min<std::size_t>(K, p.rays.size() - i0));
+        const int n = int(paths.size());
         // Gathered per lane: the diffuse vertices' ray direction, normals,
         // hit point, albedo and part weights, throughput, draws.
         alignas(64) float dir[3][K], gn[3][K], sn[3][K], point[3][K], albedo[3][K], beta[3][K];
@@ -358,7 +374,7 @@ private:
         std::uint32_t diffuse = 0, mirror = 0, nothing_to_do = 0;
         const bool spawn = depth < spawn_below_;
         for (int l = 0; l < n; ++l) {
-            const std::size_t i = i0 + std::size_t(l);
+            const std::size_t i = paths[std::size_t(l)];
             const Hitf& hit = p.hits[i];
             if (!hit.found()) continue;
             const Rayf& ray = p.rays[i];
@@ -397,16 +413,12 @@ private:
             u1[l] = u.x;
             u2[l] = u.y;
         }
-        // Paths outside the lanes: a miss adds the background in place
-        // (bounce()'s miss), the rest go through bounce().
-        const auto one_by_one = [&](std::size_t i) {
-            if (p.hits[i].found()) bounce(i, depth, s);
-            else s.radiance[p.sample[i]] += p.throughput[i] * scene_.background;
-        };
+        // Paths outside the lanes (lights' surfaces, glossy lobes, glass).
+        const auto one_by_one = [&](std::size_t i) { bounce(i, depth, s); };
         const std::uint32_t in_lanes = diffuse | mirror;
         if (in_lanes == 0) {
             for (int l = 0; l < n; ++l)
-                if (!((nothing_to_do >> l) & 1u)) one_by_one(i0 + std::size_t(l));
+                if (!((nothing_to_do >> l) & 1u)) one_by_one(paths[std::size_t(l)]);
             return;
         }
         // Lanes that are not vertices of the lanes compute garbage that is
@@ -462,7 +474,7 @@ private:
             for (int a = 0; a < 3; ++a) target[a][l] = light_n[a][l] = color[a][l] = 0.0f;
             pdf_area[l] = 1.0f;
             if (!((diffuse >> l) & 1u) || n_lights == 0) continue;
-            const std::size_t i = i0 + std::size_t(l);
+            const std::size_t i = paths[std::size_t(l)];
             const Sample2 u = drawn(s, i, 1);
             const std::size_t pick = std::min(n_lights - 1, std::size_t(u.x * choose));
             Vec3f t, c;
@@ -581,7 +593,7 @@ private:
             v.z = lanes[2][l];
         };
         for (int l = 0; l < n; ++l) {
-            const std::size_t i = i0 + std::size_t(l);
+            const std::size_t i = paths[std::size_t(l)];
             if (!((in_lanes >> l) & 1u)) {
                 if (!((nothing_to_do >> l) & 1u)) one_by_one(i);
                 continue;
