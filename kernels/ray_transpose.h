@@ -15,11 +15,8 @@ namespace raypack {
 static_assert(sizeof(Rayf) == 32, "a Rayf must be eight floats for the transposed load");
 static_assert(sizeof(Hitf) == 16, "a Hitf must be four 32-bit words for the transposed store");
 
-/// Rows of 8 rays (org.x, org.y, org.z, dir.x, dir.y, dir.z, tnear, tfar),
-/// transposed: row[f] lane i is field f of ray i.
-inline void transpose_rays8(const Rayf* rays, __m256 (&row)[8]) {
-    __m256 r[8];
-    for (int i = 0; i < 8; ++i) r[i] = _mm256_loadu_ps(reinterpret_cast<const float*>(rays + i));
+/// An 8 x 8 transpose in registers: lane j of r[i] goes to lane i of r[j].
+inline void transpose8x8(__m256 (&r)[8]) {
     const __m256 t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpackhi_ps(r[0], r[1]);
     const __m256 t2 = _mm256_unpacklo_ps(r[2], r[3]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
     const __m256 t4 = _mm256_unpacklo_ps(r[4], r[5]), t5 = _mm256_unpackhi_ps(r[4], r[5]);
@@ -28,14 +25,27 @@ inline void transpose_rays8(const Rayf* rays, __m256 (&row)[8]) {
     const __m256 s2 = _mm256_shuffle_ps(t1, t3, 0x44), s3 = _mm256_shuffle_ps(t1, t3, 0xEE);
     const __m256 s4 = _mm256_shuffle_ps(t4, t6, 0x44), s5 = _mm256_shuffle_ps(t4, t6, 0xEE);
     const __m256 s6 = _mm256_shuffle_ps(t5, t7, 0x44), s7 = _mm256_shuffle_ps(t5, t7, 0xEE);
-    row[0] = _mm256_permute2f128_ps(s0, s4, 0x20);
-    row[1] = _mm256_permute2f128_ps(s1, s5, 0x20);
-    row[2] = _mm256_permute2f128_ps(s2, s6, 0x20);
-    row[3] = _mm256_permute2f128_ps(s3, s7, 0x20);
-    row[4] = _mm256_permute2f128_ps(s0, s4, 0x31);
-    row[5] = _mm256_permute2f128_ps(s1, s5, 0x31);
-    row[6] = _mm256_permute2f128_ps(s2, s6, 0x31);
-    row[7] = _mm256_permute2f128_ps(s3, s7, 0x31);
+    r[0] = _mm256_permute2f128_ps(s0, s4, 0x20);
+    r[1] = _mm256_permute2f128_ps(s1, s5, 0x20);
+    r[2] = _mm256_permute2f128_ps(s2, s6, 0x20);
+    r[3] = _mm256_permute2f128_ps(s3, s7, 0x20);
+    r[4] = _mm256_permute2f128_ps(s0, s4, 0x31);
+    r[5] = _mm256_permute2f128_ps(s1, s5, 0x31);
+    r[6] = _mm256_permute2f128_ps(s2, s6, 0x31);
+    r[7] = _mm256_permute2f128_ps(s3, s7, 0x31);
+}
+
+/// Rows of 8 rays (org.x, org.y, org.z, dir.x, dir.y, dir.z, tnear, tfar),
+/// transposed: row[f] lane i is field f of ray i.
+inline void transpose_rays8(const Rayf* rays, __m256 (&row)[8]) {
+    for (int i = 0; i < 8; ++i) row[i] = _mm256_loadu_ps(reinterpret_cast<const float*>(rays + i));
+    transpose8x8(row);
+}
+
+/// The other way: rows of fields (transpose_rays8's) as 8 consecutive rays.
+inline void store_rays8(__m256 (&row)[8], Rayf* rays) {
+    transpose8x8(row);
+    for (int i = 0; i < 8; ++i) _mm256_storeu_ps(reinterpret_cast<float*>(rays + i), row[i]);
 }
 
 /// Four rows of 8 lanes (t, prim's bits, u, v) as 8 consecutive hits.

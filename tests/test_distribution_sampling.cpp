@@ -15,6 +15,7 @@
 #include "render/sampler.h"
 #include "render/sampling.h"
 #include "render/sin_cos_turns.h"
+#include "render/camera_samples.h"
 #include "render/thin_lens.h"
 #include "scene/scene.h"
 
@@ -282,4 +283,39 @@ TEST(SinCosTurns, CloseToLibmAndTheSameInLanes) {
         }
     }
 #endif
+}
+
+// CameraSampleBatch draws a pinhole's box-filtered rays eight at a time:
+// each ray is camera_ray_of_sample's bit for bit, whether a pixel's samples
+// fill the lanes or lanes span pixels, and in the tail.
+TEST(CameraSamples, RaysInLanesAreTheScalarRaysBitForBit) {
+    raypack::Camera camera;
+    camera.from = {1, 2, 3};
+    camera.at = {0, 0.5f, 0};
+    camera.up = {0, 1, 0};
+    camera.fov_deg = 40;
+    camera.hither = 0.01f;
+    const raypack::CameraFrame frame = raypack::make_camera_frame(camera, 7, 5);
+    std::vector<raypack::PixelXY> pixels;
+    for (int y = 0; y < 5; ++y)
+        for (int x = 0; x < 7; ++x) pixels.push_back({x, y});
+    for (const int spp : {1, 3, 8, 13, 16}) {
+        const Sampler sampler(SamplerKind::Stratified, spp, 7);
+        raypack::CameraSampleBatch batch;
+        std::vector<raypack::Rayf> rays(pixels.size() * std::size_t(spp));
+        batch.draw(frame, camera, sampler, raypack::PixelFilter::Box, pixels, 7, 0, spp, rays.data());
+        std::size_t i = 0;
+        for (const raypack::PixelXY& px : pixels)
+            for (int k = 0; k < spp; ++k, ++i) {
+                const raypack::Rayf want = raypack::camera_ray_of_sample(frame, camera, raypack::PixelFilter::Box,
+                                                                         batch.position[i], {}, px.x, px.y);
+                const float got_f[8] = {rays[i].org.x, rays[i].org.y, rays[i].org.z, rays[i].dir.x,
+                                        rays[i].dir.y, rays[i].dir.z, rays[i].tnear, rays[i].tfar};
+                const float want_f[8] = {want.org.x, want.org.y, want.org.z, want.dir.x,
+                                         want.dir.y, want.dir.z, want.tnear, want.tfar};
+                for (int c = 0; c < 8; ++c)
+                    ASSERT_EQ(std::bit_cast<std::uint32_t>(got_f[c]), std::bit_cast<std::uint32_t>(want_f[c]))
+                        << "spp " << spp << " sample " << i << " field " << c;
+            }
+    }
 }
