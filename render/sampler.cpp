@@ -315,7 +315,6 @@ void Sampler::get_many(std::span<const Draw> draws, int dimension, Sample2* out)
     const bool pow2_strata = kind_ == SamplerKind::Stratified && log2_nx_ >= 0 && log2_ny_ >= 0;
     if (pow2_strata || kind_ == SamplerKind::Random || kind_ == SamplerKind::Sobol) {
         const auto dim = std::uint64_t(dimension);
-        alignas(32) float x[8], y[8];
         for (; j + 8 <= draws.size(); j += 8) {
             // Built from the elements, not loaded from a stack copy: eight
             // stores then one wide load stall on store forwarding (a sixth
@@ -357,9 +356,11 @@ void Sampler::get_many(std::span<const Draw> draws, int dimension, Sample2* out)
                 fx = _mm256_mul_ps(_mm256_add_ps(_mm256_cvtepi32_ps(cx), jx), _mm256_set1_ps(float(inv_nx_)));
                 fy = _mm256_mul_ps(_mm256_add_ps(_mm256_cvtepi32_ps(cy), jy), _mm256_set1_ps(float(inv_ny_)));
             }
-            _mm256_store_ps(x, fx);
-            _mm256_store_ps(y, fy);
-            for (int l = 0; l < 8; ++l) out[j + std::size_t(l)] = {x[l], y[l]};
+            // (x, y) pairs in lane order: two stores, not sixteen.
+            static_assert(sizeof(Sample2) == 2 * sizeof(float));
+            const __m256 lo = _mm256_unpacklo_ps(fx, fy), hi = _mm256_unpackhi_ps(fx, fy);
+            _mm256_storeu_ps(&out[j].x, _mm256_permute2f128_ps(lo, hi, 0x20));
+            _mm256_storeu_ps(&out[j + 4].x, _mm256_permute2f128_ps(lo, hi, 0x31));
         }
     }
 #endif
