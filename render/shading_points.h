@@ -80,7 +80,7 @@ struct Attenuation {
 /// `intensity` and the attenuation. Returns the number of rays appended.
 /// Bit for bit what the scalar expressions of the recursive tracer give
 /// (tests/test_render_identity.cpp): the lanes do the same operations in the
-/// same order, and powf runs per lane.
+/// same order, phong_power included.
 std::size_t shade_point_light(const ShadingPoints& points, const PointLight& light, float intensity,
                               const Attenuation& attenuation, const RayOffset& offset, ShadowQueue& out);
 

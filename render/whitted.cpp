@@ -12,6 +12,7 @@
 #include "render/camera_rays.h"
 #include "render/camera_samples.h"
 #include "render/light_sampling.h"
+#include "render/phong_power.h"
 #include "render/sampling.h"
 #include "render/shade_lanes.h"
 #include "render/shading_points.h"
@@ -483,14 +484,14 @@ private:
         }
     }
 
-    /// The largest cos below which powf(cos, shine) is exactly +0 in glibc:
-    /// its powf returns +0 once shine * log2(cos) <= -150 (computed in
-    /// double, far more precisely than the margin of 2 below), so skipping
-    /// the call there gives the same bits. On mount, whose highlights have a
-    /// shine of 101, the underflowing calls were 5% of the render.
+    /// A cos at or below which phong_power(cos, shine) is exactly +0: it is
+    /// +0 once shine * log2(cos) < -125, and its log2 is far more precise than
+    /// the margin of 1 below, so skipping the call there gives the same bits.
+    /// On mount, whose highlights have a shine of 101, the underflowing calls
+    /// were 5% of the render.
     static float specular_cutoff(float shine) {
         if (!(shine > 0)) return 0.0f;
-        return std::nextafter(float(std::exp2(-152.0 / double(shine))), 0.0f);
+        return std::nextafter(float(std::exp2(-126.0 / double(shine))), 0.0f);
     }
 
     /// Ambient-free light of one unoccluded light of colour `light_color`
@@ -500,7 +501,7 @@ private:
         const float diffuse = m.kd * dot(ns, l);
         const Vec3f r = ns * (2.0f * dot(ns, l)) - l;  // mirror of l about the normal
         const float rv = std::max(0.0f, -dot(r, view));
-        const float specular = m.ks > 0 && rv > cutoff ? m.ks * std::pow(rv, m.shine) : 0.0f;
+        const float specular = m.ks > 0 && rv > cutoff ? m.ks * phong_power(rv, m.shine) : 0.0f;
         return light_color * m.color * diffuse + light_color * specular;
     }
 

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "render/camera_rays.h"
+#include "render/phong_power.h"
 #include "render/surface.h"
 
 namespace raypack::reference {
@@ -74,7 +75,7 @@ private:
             const float diffuse = m.kd * dot(ns, l);
             const Vec3f r = ns * (2.0f * dot(ns, l)) - l;  // mirror of l about the normal
             const float rv = std::max(0.0f, -dot(r, view));
-            const float specular = m.ks > 0 && rv > 0 ? m.ks * std::pow(rv, m.shine) : 0.0f;
+            const float specular = m.ks > 0 && rv > 0 ? m.ks * phong_power(rv, m.shine) : 0.0f;
             color += light_color * m.color * diffuse + light_color * specular;
         }
         if (depth >= options_.max_depth) return color;

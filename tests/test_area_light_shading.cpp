@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "render/light_sampling.h"
+#include "render/phong_power.h"
 #include "render/ray_offset.h"
 #include "render/shading_points.h"
 
@@ -48,7 +49,7 @@ void scalar_shading(const Point& p, std::int32_t owner, const AreaLight& light, 
         const float diffuse = p.m.kd * dot(p.ns, l);
         const Vec3f r = p.ns * (2.0f * dot(p.ns, l)) - l;
         const float rv = std::max(0.0f, -dot(r, p.view));
-        const float specular = p.m.ks > 0 && rv > p.cutoff ? p.m.ks * std::pow(rv, p.m.shine) : 0.0f;
+        const float specular = p.m.ks > 0 && rv > p.cutoff ? p.m.ks * phong_power(rv, p.m.shine) : 0.0f;
         out.contribution.push_back(share * p.m.color * diffuse + share * specular);
     }
 }

@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 #include "tests/test_paths.h"
 
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
@@ -11,6 +13,7 @@
 #include "accel/accel.h"
 #include "render/camera_rays.h"
 #include "render/image.h"
+#include "render/phong_power.h"
 #include "render/whitted.h"
 #include "scene/load.h"
 
@@ -281,6 +284,41 @@ TEST(Render, PacketPrimaryRaysGiveTheSameImage) {
         EXPECT_EQ(st.eye_rays, 67u * 45u);
         EXPECT_EQ(packed.rgb, single.rgb) << "packet width " << width;
     }
+}
+
+// phong_power: x^n within n |log2 x| 2^-22 of the double-precision power
+// (relative), exact at x = 1 and at n = 0, +0 at and below the cut-off the
+// Whitted shading skips the call at (exp2(-126 / n), rounded down), and
+// the 8-lane form the scalar one bit for bit.
+TEST(PhongPower, CloseToPowExactAtTheEndsAndTheSameInLanes) {
+    for (const float n : {0.5f, 1.0f, 2.0f, 3.5f, 10.0f, 20.0f, 101.0f, 1000.0f}) {
+        for (int k = 1; k <= 1 << 16; ++k) {
+            const float x = float(k) * 0x1.0p-16f;
+            const double want = std::pow(double(x), double(n));
+            if (want < 0x1.0p-124) continue;
+            const double bound = (double(n) * std::fabs(std::log2(double(x))) + 1.0) * 0x1.0p-22;
+            EXPECT_NEAR(phong_power(x, n) / want, 1.0, bound) << x << "^" << n;
+        }
+        EXPECT_EQ(phong_power(1.0f, n), 1.0f);
+        const float cutoff = std::nextafter(float(std::exp2(-126.0 / double(n))), 0.0f);
+        if (cutoff > 0) {
+            EXPECT_EQ(phong_power(cutoff, n), 0.0f) << n;
+        }
+        EXPECT_EQ(phong_power(0.25f, 0.0f), 1.0f);
+    }
+#if defined(__AVX2__)
+    using F = vfloat<8>;
+    alignas(32) float x[8], got[8];
+    for (const float n : {1.0f, 7.0f, 101.0f}) {
+        for (int k = 0; k < 4096; k += 8) {
+            for (int l = 0; l < 8; ++l) x[l] = float(k + l + 1) / 4096.0f;
+            phong_power(F::load_aligned(x), F(n)).store_aligned(got);
+            for (int l = 0; l < 8; ++l)
+                ASSERT_EQ(std::bit_cast<std::uint32_t>(got[l]), std::bit_cast<std::uint32_t>(phong_power(x[l], n)))
+                    << x[l] << "^" << n;
+        }
+    }
+#endif
 }
 
 }  // namespace
