@@ -354,14 +354,13 @@ private:
         spawn_ray(origin, dir, offset_, s.next.add(next_beta, si, specular, bounce_pdf, origin));
     }
 
-    /// bounce() for the paths `paths` (at most kShadeLanes, each of which
-    /// found a surface), bit for bit: the
-    /// diffuse and perfect-mirror vertices (the common cases) in SIMD lanes,
-    /// with bounce's operations in bounce's order (FMA contraction is off);
-    /// the others (misses, lights' surfaces, glossy
+    /// bounce() for `paths` (at most kShadeLanes, each of which found a
+    /// surface), bit for bit: the diffuse and perfect-mirror vertices (the
+    /// common cases) in SIMD lanes, with bounce's operations in bounce's
+    /// order (FMA contraction is off); the others (lights' surfaces, glossy
     /// lobes, glass) one by one through bounce(). Rays and shadow rays are
-    /// appended in path order, as bounce() appends them. Needs depth <
-    /// max_depth.
+    /// appended in the order of `paths`, as bounce() appends them. Needs
+    /// depth < max_depth.
     void bounce_lanes(std::span<const std::uint32_t> paths, int depth, Scratch& s) const {
         constexpr int K = kShadeLanes;
         using F = vfloat<K>;
@@ -376,7 +375,6 @@ private:
         for (int l = 0; l < n; ++l) {
             const std::size_t i = paths[std::size_t(l)];
             const Hitf& hit = p.hits[i];
-            if (!hit.found()) continue;
             const Rayf& ray = p.rays[i];
             const Surface surf = surfaces_.at(ray, hit);
             if (scene_.materials[surf.material].area_light >= 0) continue;
