@@ -11,16 +11,6 @@ Vec3f triangle_normal(const TriangleSoA& t, std::uint32_t i) {
     return normalize(cross(t.p1[i] - t.p0[i], t.p2[i] - t.p0[i]));
 }
 
-}  // namespace
-
-Vec3f smooth_normal(const TriangleSoA& t, std::uint32_t i, const Hitf& hit, const Vec3f& ng) {
-    const float w = 1.0f - hit.u - hit.v;
-    const Vec3f n = t.n0[i] * w + t.n1[i] * hit.u + t.n2[i] * hit.v;
-    return length(n) > 0 ? normalize(n) : ng;
-}
-
-namespace {
-
 /// surface_at in `scene` (the top scene or an object) of the top scene
 /// `top`; `mirrored`: the instances on the way turn space inside out, so a
 /// triangle's winding normal flips as the flattened triangle's would.
