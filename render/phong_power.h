@@ -7,7 +7,7 @@
 // Method: exp2(n log2 x). log2 from Cephes' logf (Moshier: the exponent, and
 // a degree-9 polynomial of the mantissa folded into [sqrt(1/2), sqrt(2))),
 // exp2 from Cephes' exp2f (the nearest integer, and a degree-6 polynomial
-// of the rest in [-1/2, 1/2]); results below 2^-126 are +0. Relative error
+// of the rest in [-1/2, 1/2]); results below 2^-125 are +0. Relative error
 // about n |log2 x| 2^-23 (a highlight's exponent magnifies log2's error):
 // far below what an 8-bit pixel shows.
 #include <bit>
