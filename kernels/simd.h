@@ -242,6 +242,15 @@ RAYPACK_INLINE xsimd::batch<float, A> copysign_of(const xsimd::batch<float, A>& 
     return xsimd::copysign(x, s);
 }
 
+/// Rounding to the nearest integer (ties to even, the default mode) and
+/// down, at every width: roundps in lanes, the same results as the scalars.
+RAYPACK_INLINE float round_nearest(float x) { return std::nearbyint(x); }
+RAYPACK_INLINE float round_down(float x) { return std::floor(x); }
+template <class A>
+RAYPACK_INLINE xsimd::batch<float, A> round_nearest(const xsimd::batch<float, A>& x) { return xsimd::nearbyint(x); }
+template <class A>
+RAYPACK_INLINE xsimd::batch<float, A> round_down(const xsimd::batch<float, A>& x) { return xsimd::floor(x); }
+
 /// Mask lanes as bits, lane i in bit i.
 RAYPACK_INLINE std::uint32_t mask_bits(bool m) { return m ? 1u : 0u; }
 template <class A>

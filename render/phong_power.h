@@ -23,7 +23,6 @@ namespace phong_power_detail {
 RAYPACK_INLINE std::int32_t bits_of(float x) { return std::bit_cast<std::int32_t>(x); }
 RAYPACK_INLINE float float_of(std::int32_t i) { return std::bit_cast<float>(i); }
 RAYPACK_INLINE float to_float(std::int32_t i) { return float(i); }
-RAYPACK_INLINE float round_nearest(float x) { return std::nearbyint(x); }
 RAYPACK_INLINE std::int32_t to_int(float x) { return std::int32_t(x); }  // exact: x is integral
 template <class A>
 RAYPACK_INLINE auto bits_of(const xsimd::batch<float, A>& x) {
@@ -36,10 +35,6 @@ RAYPACK_INLINE auto float_of(const xsimd::batch<std::int32_t, A>& i) {
 template <class A>
 RAYPACK_INLINE auto to_float(const xsimd::batch<std::int32_t, A>& i) {
     return xsimd::to_float(i);
-}
-template <class A>
-RAYPACK_INLINE auto round_nearest(const xsimd::batch<float, A>& x) {
-    return xsimd::nearbyint(x);
 }
 template <class A>
 RAYPACK_INLINE auto to_int(const xsimd::batch<float, A>& x) {

@@ -18,20 +18,10 @@
 
 namespace raypack {
 
-namespace sin_cos_detail {
-RAYPACK_INLINE float round_nearest(float x) { return std::nearbyint(x); }
-RAYPACK_INLINE float round_down(float x) { return std::floor(x); }
-template <class A>
-RAYPACK_INLINE xsimd::batch<float, A> round_nearest(const xsimd::batch<float, A>& x) { return xsimd::nearbyint(x); }
-template <class A>
-RAYPACK_INLINE xsimd::batch<float, A> round_down(const xsimd::batch<float, A>& x) { return xsimd::floor(x); }
-}  // namespace sin_cos_detail
-
 /// sin and cos of 2 pi u, for any finite u (exact turns give exact 0 and
 /// +-1). F is float or a float batch; both compute the same bits.
 template <class F>
 RAYPACK_INLINE void sin_cos_turns(F u, F& sin_out, F& cos_out) {
-    using sin_cos_detail::round_down, sin_cos_detail::round_nearest;
     const F q = round_nearest(u * F(4.0f));
     const F x = (u - q * F(0.25f)) * F(2.0f * std::numbers::pi_v<float>);
     const F z = x * x;
