@@ -49,6 +49,9 @@ struct AccelConfig {
     /// embree, embree-robust: Embree's build quality, low | medium | high
     /// (RTC_BUILD_QUALITY_*; medium is Embree's own default).
     std::string build_quality = "medium";
+    /// bvh4, bvh8: packets that share one walk (accel/bvh/wide_group_traversal.h);
+    /// 0: the default (default_wide_packet_config), 1: each packet alone.
+    int packet_group = 0;
 };
 
 /// Embree's two modes: `embree` (its default, fast mode) and `embree-robust`

@@ -36,44 +36,98 @@ RAYPACK_INLINE void store_packet_hits(const HitPacket<K>& hit, const vmask<K>& o
 }
 #endif
 
+/// A packet's answers into hits[first, first + n) (n <= K), in the exchange
+/// layout (for any hit, prim 0 where occluded).
+template <int K, bool AnyHit>
+RAYPACK_INLINE void store_packet(const HitPacket<K>& hit, const vmask<K>& occluded, std::span<Hitf> hits,
+                                 std::size_t first, std::size_t n) {
+#if defined(__AVX2__)
+    if constexpr (K == 8 || K == 16) {
+        if (n == std::size_t(K)) {
+            store_packet_hits<K, AnyHit>(hit, occluded, hits.data() + first);
+            return;
+        }
+    }
+#endif
+    alignas(64) float t[K], u[K], v[K];
+    store_lanes(t, hit.t);
+    store_lanes(u, hit.u);
+    store_lanes(v, hit.v);
+    const std::uint32_t occ = mask_bits(occluded);
+    for (std::size_t i = 0; i < n; ++i) {
+        if constexpr (AnyHit) {
+            hits[first + i] = Hitf{};
+            if ((occ >> i) & 1u) hits[first + i].prim = 0;
+        } else {
+            hits[first + i] = Hitf{t[i], hit.prim[i], u[i], v[i]};
+        }
+    }
+}
+
+/// A packet of up to K rays from rays[first...], with no hit yet.
+template <int K>
+struct LoadedPacket {
+    RayPacket<K> ray;
+    HitPacket<K> hit;
+    vmask<K> valid, occluded;
+    std::size_t n;
+};
+template <int K>
+RAYPACK_INLINE void load_fresh_packet(std::span<const Rayf> rays, std::size_t first, RcpMethod rcp,
+                                      LoadedPacket<K>& p) {
+    using F = vfloat<K>;
+    p.n = std::min<std::size_t>(K, rays.size() - first);
+    p.ray = load_packet<K>(rays.subspan(first, p.n), p.valid, rcp);
+    p.hit.t = F(std::numeric_limits<float>::infinity());
+    p.hit.u = p.hit.v = F(0.0f);
+    for (auto& prim : p.hit.prim) prim = kNoPrim;
+    p.occluded = p.valid & !p.valid;
+}
+
 /// `trace_packet(ray, hit, valid, occluded)` traces one packet: it records
 /// closest hits in `hit`, or sets the `occluded` lanes for any-hit queries.
 /// `rcp` computes the packets' reciprocal directions (`--rcp`).
 template <int K, bool AnyHit, class TracePacket>
 void trace_in_packets(std::span<const Rayf> rays, std::span<Hitf> hits, RcpMethod rcp, TracePacket&& trace_packet) {
-    using F = vfloat<K>;
+    LoadedPacket<K> p;
     for (std::size_t first = 0; first < rays.size(); first += K) {
-        const std::size_t n = std::min<std::size_t>(K, rays.size() - first);
-        vmask<K> valid;
-        RayPacket<K> ray = load_packet<K>(rays.subspan(first, n), valid, rcp);
-        HitPacket<K> hit;
-        hit.t = F(std::numeric_limits<float>::infinity());
-        hit.u = hit.v = F(0.0f);
-        for (auto& p : hit.prim) p = kNoPrim;
-        vmask<K> occluded = valid & !valid;
-        trace_packet(ray, hit, valid, occluded);
-#if defined(__AVX2__)
-        if constexpr (K == 8 || K == 16) {
-            if (n == std::size_t(K)) {
-                store_packet_hits<K, AnyHit>(hit, occluded, hits.data() + first);
+        load_fresh_packet<K>(rays, first, rcp, p);
+        trace_packet(p.ray, p.hit, p.valid, p.occluded);
+        store_packet<K, AnyHit>(p.hit, p.occluded, hits, first, p.n);
+    }
+}
+
+/// The same in groups of up to G consecutive packets (G * K rays):
+/// `trace_group(packets, count)` traces `count` loaded packets together. A
+/// packet for which `may_lead(packet)` is false cannot start a group (its
+/// rays are not coherent enough to share a walk): it is traced alone with
+/// `trace_packet`, without waiting for the packets after it.
+template <int K, int G, bool AnyHit, class MayLead, class TracePacket, class TraceGroup>
+void trace_in_groups(std::span<const Rayf> rays, std::span<Hitf> hits, RcpMethod rcp, MayLead&& may_lead,
+                     TracePacket&& trace_packet, TraceGroup&& trace_group) {
+    LoadedPacket<K> p[G];
+    std::size_t group_first = 0;
+    int count = 0;
+    auto flush = [&] {
+        trace_group(p, count);
+        for (int g = 0; g < count; ++g)
+            store_packet<K, AnyHit>(p[g].hit, p[g].occluded, hits, group_first + std::size_t(g) * K, p[g].n);
+        count = 0;
+    };
+    for (std::size_t first = 0; first < rays.size(); first += K) {
+        LoadedPacket<K>& next = p[count];
+        load_fresh_packet<K>(rays, first, rcp, next);
+        if (count == 0) {
+            if (!may_lead(next)) {
+                trace_packet(next.ray, next.hit, next.valid, next.occluded);
+                store_packet<K, AnyHit>(next.hit, next.occluded, hits, first, next.n);
                 continue;
             }
+            group_first = first;
         }
-#endif
-        alignas(64) float t[K], u[K], v[K];
-        store_lanes(t, hit.t);
-        store_lanes(u, hit.u);
-        store_lanes(v, hit.v);
-        const std::uint32_t occ = mask_bits(occluded);
-        for (std::size_t i = 0; i < n; ++i) {
-            if constexpr (AnyHit) {
-                hits[first + i] = Hitf{};
-                if ((occ >> i) & 1u) hits[first + i].prim = 0;
-            } else {
-                hits[first + i] = Hitf{t[i], hit.prim[i], u[i], v[i]};
-            }
-        }
+        if (++count == G) flush();
     }
+    if (count != 0) flush();
 }
 
 }  // namespace raypack

@@ -4,12 +4,13 @@
 #include <tbb/info.h>
 
 #include "accel/bvh/bvh_builders.h"
+#include "accel/bvh/wide_packet.h"
 
 namespace raypack::app {
 
 std::vector<OptionSpec> accel_option_specs() {
     std::vector<OptionSpec> specs = {{"--accel", "", 1}, {"--packet", "", 1}, {"--builder", "", 1},
-                                       {"--embree-quality", "", 1}};
+                                       {"--embree-quality", "", 1}, {"--group", "", 1}};
     for (OptionSpec& k : kernel_option_specs()) specs.push_back(std::move(k));
     return specs;
 }
@@ -75,7 +76,9 @@ std::string accel_options_help() {
            "  --embree-quality low|medium|high  Embree's build quality (default medium, Embree's own);\n"
            "                embree is Embree's fast mode, embree-robust its robust mode\n"
            + kernel_options_help() +
-           "  --packet 1|4|8|16             rays per packet (default 1; 16 needs AVX-512)\n";
+           "  --packet 1|4|8|16             rays per packet (default 1; 16 needs AVX-512)\n"
+           "  --group G                     bvh4|bvh8: packets that walk the tree together when their\n"
+           "                rays share a direction octant (default 128 rays' worth; 1: each alone)\n";
 }
 
 std::vector<OptionSpec> kernel_option_specs() {
@@ -117,6 +120,11 @@ AccelConfig accel_config_from(const ParsedArgs& args) {
             throw UsageError("--builder: unknown builder '" + config.builder + "' (expected " + bvh_builder_list() + ")");
         if (config.kind != "bvh2" && config.kind != "bvh4" && config.kind != "bvh8")
             throw UsageError("--builder applies to bvh2, bvh4 and bvh8 only, not to --accel " + config.kind);
+    }
+    if (args.has("--group")) {
+        config.packet_group = int(args.integer("--group", 1, 1, WidePacketConfig::kMaxGroupPackets));
+        if (!uses_fastest_config(args) && config.kind != "bvh4" && config.kind != "bvh8")
+            throw UsageError("--group applies to bvh4 and bvh8 only, not to --accel " + config.kind);
     }
     config.kernels = kernel_choice_from(args);
     config.build_quality = embree_quality_from(args, config.kind);

@@ -85,9 +85,11 @@ std::string describe(const Hitf& h, bool any_hit) {
 }  // namespace
 
 BenchRays make_bench_rays(const Scene& scene, const std::string& kind, int width, int height, OffsetPolicy offset) {
-    if (kind == "camera") return {kind, false, camera_ray_set(scene, width, height)};
-    if (kind == "shadow") return {kind, true, shadow_ray_set(scene, width, height, offset)};
-    if (kind == "diffuse") return {kind, false, diffuse_ray_set(scene, width, height, 1, offset)};
+    // In tiles, as `raypack rays` writes them (measure/ray_sets.h).
+    constexpr PixelOrder kOrder = PixelOrder::Tiles;
+    if (kind == "camera") return {kind, false, camera_ray_set(scene, width, height, nullptr, kOrder)};
+    if (kind == "shadow") return {kind, true, shadow_ray_set(scene, width, height, offset, nullptr, kOrder)};
+    if (kind == "diffuse") return {kind, false, diffuse_ray_set(scene, width, height, 1, offset, nullptr, kOrder)};
     throw std::invalid_argument("unknown ray kind '" + kind + "' (expected camera, shadow or diffuse)");
 }
 

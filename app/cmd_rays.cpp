@@ -1,4 +1,4 @@
-// raypack rays SCENE --kind camera|shadow|diffuse [--res W H] [--seed S] [--offset POLICY] -o FILE.rays
+// raypack rays SCENE --kind camera|shadow|diffuse [--res W H] [--order tiles|rows] [--seed S] [--offset POLICY] -o FILE.rays
 // Writes the ray sets the benchmarks and the Embree comparison trace.
 #include <cmath>
 #include <cstdio>
@@ -16,17 +16,20 @@ namespace raypack::app {
 
 int run_rays(const Args& args) {
     std::vector<OptionSpec> spec = {{"--kind", "", 1}, {"--res", "", 2}, {"--output", "-o", 1}, {"--seed", "", 1},
-                                    offset_option_spec()};
+                                    {"--order", "", 1}, offset_option_spec()};
     for (OptionSpec& k : scene_option_specs()) spec.push_back(std::move(k));
     const ParsedArgs p(args, spec, 1);
     if (p.help() || p.positional().empty()) {
         std::printf(
-            "usage: raypack rays SCENE --kind camera|shadow|diffuse [--res W H] [--seed S] [--offset POLICY]\n"
-            "                   -o FILE.rays\n"
+            "usage: raypack rays SCENE --kind camera|shadow|diffuse [--res W H] [--order tiles|rows] [--seed S]\n"
+            "                   [--offset POLICY] -o FILE.rays\n"
             "  camera   one closest-hit ray through each pixel centre (kind 0)\n"
             "  shadow   any-hit rays from each camera hit to the first light (kind 1): a point light,\n"
             "           else a distant one, else an area light's centre (a sphere's facing point)\n"
             "  diffuse  a cosine-weighted bounce from each camera hit (kind 0); --seed S (default 1)\n"
+            "--order tiles (the default): pixels in tiles of 8 x 8, each in 4 x 4 blocks, so that every 8 or 16\n"
+            "consecutive rays cover a 4 x 2 or 4 x 4 patch of the image, as a renderer's packets do; rows: row by\n"
+            "row from the top. Shadow and diffuse rays follow their pixels' order.\n"
             "A scene that moves (shutter, move) gives each pixel's rays a time over the shutter\n"
             "(a version 2 file, docs/rays.md).\n"
             "%s",
@@ -37,6 +40,10 @@ int run_rays(const Args& args) {
     if (!p.has("--output")) throw UsageError("missing -o FILE.rays");
     const std::string kind = p.text("--kind", "camera");
     const OffsetPolicy offset = offset_policy_from(p);
+    const std::string order_name = p.text("--order", "tiles");
+    if (order_name != "tiles" && order_name != "rows")
+        throw UsageError("--order: expected tiles or rows, got '" + order_name + "'");
+    const PixelOrder order = order_name == "tiles" ? PixelOrder::Tiles : PixelOrder::Rows;
     const Scene scene = load_scene_from(p, p.positional()[0]);
     const int w = int(p.integer("--res", scene.camera.width, 1, 16384, 0));
     const int h = int(p.integer("--res", scene.camera.height, 1, 16384, 1));
@@ -44,12 +51,12 @@ int run_rays(const Args& args) {
     std::vector<float> times;  // a scene that moves: one per ray (a version 2 file)
     RayKind file_kind = RayKind::ClosestHit;
     if (kind == "camera") {
-        rays = camera_ray_set(scene, w, h, &times);
+        rays = camera_ray_set(scene, w, h, &times, order);
     } else if (kind == "shadow") {
-        rays = shadow_ray_set(scene, w, h, offset, &times);
+        rays = shadow_ray_set(scene, w, h, offset, &times, order);
         file_kind = RayKind::AnyHit;
     } else if (kind == "diffuse") {
-        rays = diffuse_ray_set(scene, w, h, std::uint64_t(p.integer("--seed", 1, 0, 1LL << 62)), offset, &times);
+        rays = diffuse_ray_set(scene, w, h, std::uint64_t(p.integer("--seed", 1, 0, 1LL << 62)), offset, &times, order);
     } else {
         throw UsageError("--kind: expected camera, shadow or diffuse, got '" + kind + "'");
     }

@@ -12,6 +12,7 @@
 #include "app/accel_options.h"
 #include "app/commands.h"
 #include "app/default_config.h"
+#include "accel/bvh/wide_packet.h"
 #include "scene/load.h"
 #include "scene/ray_file.h"
 
@@ -103,6 +104,9 @@ int run_trace(const Args& args) {
         j["accel"] = as.name;
         j["builder"] = as.builder;
         j["packet"] = packet;
+        // Packets per shared walk (bvh4, bvh8 with packets; 1: alone).
+        const bool wide = (as.name == "bvh4" || as.name == "bvh8") && packet > 1;
+        j["group"] = !wide ? 1 : config.packet_group > 0 ? config.packet_group : default_wide_packet_config(4, packet).group_packets;
         j["triangle"] = triangle_method_name(config.kernels.triangle);
         j["sphere"] = sphere_method_name(config.kernels.sphere);
         j["slabs"] = slab_method_name(config.kernels.slabs);

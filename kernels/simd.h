@@ -277,6 +277,34 @@ RAYPACK_INLINE void store_lanes(float* p, const F& v) {
     else v.store_unaligned(p);
 }
 
+/// Smallest and largest lane of x (a NaN lane may or may not be dropped).
+RAYPACK_INLINE float lane_min4(__m128 a) {
+    a = _mm_min_ps(a, _mm_shuffle_ps(a, a, _MM_SHUFFLE(1, 0, 3, 2)));
+    return _mm_cvtss_f32(_mm_min_ps(a, _mm_shuffle_ps(a, a, _MM_SHUFFLE(2, 3, 0, 1))));
+}
+template <int K>
+RAYPACK_INLINE float lane_min(const vfloat<K>& x) {
+    if constexpr (K == 16) {
+#if defined(__AVX512F__)
+        // Zero-masked extracts: gcc 12 warns on the undefined operand of
+        // _mm512_reduce_min_ps and _mm512_castps512_ps256.
+        const __m512d d = _mm512_castps_pd(x);
+        const __m256 lo = _mm256_castpd_ps(_mm512_maskz_extractf64x4_pd(__mmask8(0xFF), d, 0));
+        const __m256 hi = _mm256_castpd_ps(_mm512_maskz_extractf64x4_pd(__mmask8(0xFF), d, 1));
+        return lane_min<8>(_mm256_min_ps(lo, hi));
+#endif
+    } else if constexpr (K == 8) {
+        const __m256 v = x;
+        return lane_min4(_mm_min_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1)));
+    } else {
+        return lane_min4(x);
+    }
+}
+template <int K>
+RAYPACK_INLINE float lane_max(const vfloat<K>& x) {
+    return -lane_min<K>(-x);  // negation is exact
+}
+
 /// Lane i of v, for tests and scalar fallbacks.
 template <class F>
 float lane(const F& v, int i) {

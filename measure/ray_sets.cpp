@@ -11,6 +11,7 @@
 #include "render/ray_offset.h"
 #include "render/sampling.h"
 #include "render/surface.h"
+#include "render/tiles.h"
 
 namespace raypack {
 namespace {
@@ -50,7 +51,8 @@ Vec3f offset_origin(const Scene& scene, const RayOffset& offset, const Rayf& ray
 
 }  // namespace
 
-std::vector<Rayf> camera_ray_set(const Scene& scene, int width, int height, std::vector<float>* times) {
+std::vector<Rayf> camera_ray_set(const Scene& scene, int width, int height, std::vector<float>* times,
+                                 PixelOrder order) {
     if (times != nullptr) {
         times->clear();
         if (!scene.moving_instances.empty())
@@ -59,18 +61,27 @@ std::vector<Rayf> camera_ray_set(const Scene& scene, int width, int height, std:
     const CameraFrame frame = make_camera_frame(scene.camera, width, height);
     std::vector<Rayf> rays;
     rays.reserve(std::size_t(width) * std::size_t(height));
-    for (int y = 0; y < height; ++y)
-        for (int x = 0; x < width; ++x) rays.push_back(camera_ray(frame, float(x) + 0.5f, float(y) + 0.5f));
+    if (order == PixelOrder::Rows) {
+        for (int y = 0; y < height; ++y)
+            for (int x = 0; x < width; ++x) rays.push_back(camera_ray(frame, float(x) + 0.5f, float(y) + 0.5f));
+        return rays;
+    }
+    const TileGrid tiles{width, height, 8};
+    std::vector<PixelXY> pixels;
+    for (int t = 0; t < tiles.count(); ++t) {
+        tiles.pixels(t, pixels);
+        for (const PixelXY& p : pixels) rays.push_back(camera_ray(frame, float(p.x) + 0.5f, float(p.y) + 0.5f));
+    }
     return rays;
 }
 
 std::vector<Rayf> shadow_ray_set(const Scene& scene, int width, int height, OffsetPolicy policy,
-                                 std::vector<float>* times) {
+                                 std::vector<float>* times, PixelOrder order) {
     if (times != nullptr) times->clear();
     // The first light: a point light, else a distant one, else an area light.
     const bool point = !scene.lights.empty(), distant = !point && !scene.distant_lights.empty();
     if (!point && !distant && scene.area_lights.empty()) return {};
-    const std::vector<Rayf> camera = camera_ray_set(scene, width, height);
+    const std::vector<Rayf> camera = camera_ray_set(scene, width, height, nullptr, order);
     const std::vector<float> when = pixel_times(scene, camera.size(), times);
     const std::vector<Hitf> hits = camera_hits(scene, camera, when);
     const RayOffset offset(policy, scene);
@@ -97,9 +108,9 @@ std::vector<Rayf> shadow_ray_set(const Scene& scene, int width, int height, Offs
 }
 
 std::vector<Rayf> diffuse_ray_set(const Scene& scene, int width, int height, std::uint64_t seed, OffsetPolicy policy,
-                                  std::vector<float>* times) {
+                                  std::vector<float>* times, PixelOrder order) {
     if (times != nullptr) times->clear();
-    const std::vector<Rayf> camera = camera_ray_set(scene, width, height);
+    const std::vector<Rayf> camera = camera_ray_set(scene, width, height, nullptr, order);
     const std::vector<float> when = pixel_times(scene, camera.size(), times);
     const RayOffset offset(policy, scene);
     const std::vector<Hitf> hits = camera_hits(scene, camera, when);

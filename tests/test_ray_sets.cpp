@@ -1,11 +1,14 @@
 // The standard ray sets: diffuse bounce rays are deterministic, leave the
 // surface into the hemisphere the camera ray came from, and follow the
-// cosine law (mean cos(theta) = 2/3 for density cos(theta) / pi).
+// cosine law (mean cos(theta) = 2/3 for density cos(theta) / pi); sets in
+// tiles are the rows' rays, each once, in patches of 4 x 2 and 4 x 4.
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <utility>
 
 #include "accel/accel.h"
 #include "measure/ray_sets.h"
@@ -30,6 +33,43 @@ TEST(DiffuseRaySet, SameEveryRunAndForAnyThreadCount) {
     ASSERT_FALSE(a.empty());
     EXPECT_TRUE(same_bits(a, b));
     EXPECT_FALSE(same_bits(a, diffuse_ray_set(scene, 64, 64, 43))) << "the seed must change the directions";
+}
+
+bool same_ray(const Rayf& a, const Rayf& b) { return std::memcmp(&a, &b, sizeof(Rayf)) == 0; }
+
+TEST(CameraRaySet, TilesAreTheRowsRaysInPatches) {
+    const Scene scene = load_scene("gen:balls:1");
+    for (auto [w, h] : {std::pair{64, 48}, std::pair{37, 21}}) {
+        const std::vector<Rayf> rows = camera_ray_set(scene, w, h);
+        const std::vector<Rayf> tiles = camera_ray_set(scene, w, h, nullptr, PixelOrder::Tiles);
+        ASSERT_EQ(rows.size(), tiles.size());
+        // Each tiled ray is some pixel's, and no pixel comes twice.
+        std::vector<int> seen(rows.size(), 0);
+        std::vector<int> pixel_of(tiles.size(), -1);
+        for (std::size_t i = 0; i < tiles.size(); ++i) {
+            for (std::size_t p = 0; p < rows.size(); ++p)
+                if (!seen[p] && same_ray(rows[p], tiles[i])) {
+                    seen[p] = 1;
+                    pixel_of[i] = int(p);
+                    break;
+                }
+            ASSERT_GE(pixel_of[i], 0) << "tiled ray " << i << " is no pixel's ray (or a repeat)";
+        }
+        // Away from the ragged edges, every 8 (16) consecutive rays are a 4 x 2 (4 x 4) patch.
+        for (std::size_t first = 0; first + 16 <= tiles.size(); first += 16) {
+            int x0 = w, y0 = h, x1 = -1, y1 = -1;
+            for (std::size_t i = first; i < first + 16; ++i) {
+                const int x = pixel_of[i] % w, y = pixel_of[i] / w;
+                x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+            }
+            if (w % 8 == 0 && h % 8 == 0) {
+                EXPECT_EQ(x1 - x0, 3) << "rays " << first << "..: not 4 pixels wide";
+                EXPECT_EQ(y1 - y0, 3) << "rays " << first << "..: not 4 pixels tall";
+                const int x = pixel_of[first] % w, y = pixel_of[first] / w;
+                EXPECT_EQ(pixel_of[first + 7], (y + 1) * w + x + 3) << "the first 8 of a block are its top two rows";
+            }
+        }
+    }
 }
 
 /// Each ray against the surface it leaves: the normal facing the camera.

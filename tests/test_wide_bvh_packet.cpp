@@ -1,7 +1,8 @@
 // The BVH4/BVH8 packet traversal (accel/bvh/wide_packet.h) against the
-// single-ray wide traversal and the brute-force oracle, for K = 4, 8, 16 and
-// three switch points: never fall back (pure packets), the default, and
-// always (every lane alone below the root).
+// single-ray wide traversal and the brute-force oracle, for K = 4, 8, 16,
+// three switch points (never fall back: pure packets; the default; always:
+// every lane alone below the root) and packets alone or in groups of 4 and
+// 16 that share one walk (accel/bvh/wide_group_traversal.h).
 //
 // Against the single-ray traversal (see wide_packet_traversal.h for why):
 // the same hit or miss and the same occlusion on every ray; for the same
@@ -23,6 +24,7 @@
 #include <functional>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "accel/brute/brute_force.h"
@@ -50,12 +52,14 @@ Scene load(const std::string& spec) {
     return load_scene(spec.rfind("gen:", 0) == 0 ? spec : std::string(RAYPACK_SOURCE_DIR) + "/scenes/" + spec);
 }
 
-/// Closest hits or occlusion (prim 0) of every ray, in batches of 64 (so
-/// that every width gets a ragged last packet per batch when the count is
-/// not a multiple of it), traced with `width`.
-std::vector<Hitf> trace(const Accel& accel, int width, bool any_hit, const std::vector<Rayf>& rays) {
+/// Closest hits or occlusion (prim 0) of every ray, in batches of `grain`
+/// to 2 `grain` rays (so that every width gets a ragged last packet and
+/// group per batch when the count is not a multiple of it), traced with
+/// `width`.
+std::vector<Hitf> trace(const Accel& accel, int width, bool any_hit, const std::vector<Rayf>& rays,
+                        std::size_t grain = 61) {
     std::vector<Hitf> hits(rays.size());
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 61), [&](const auto& r) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), grain), [&](const auto& r) {
         const std::span<const Rayf> in(rays.data() + r.begin(), r.size());
         const std::span<Hitf> out(hits.data() + r.begin(), r.size());
         if (!any_hit) return accel.intersect_packets(width, in, out);
@@ -74,16 +78,23 @@ struct RaySet {
     bool any_hit = false;
 };
 
+/// Every used child box of the tree.
+template <int N>
+std::vector<Box3f> child_boxes(const WideBvh<N, 8>& bvh) {
+    std::vector<Box3f> boxes;
+    for (const WideNode<N>& node : bvh.nodes)
+        for (int i = 0; i < N; ++i)
+            if (node.child[i] != wide_child::kEmpty) boxes.push_back(node.box(i));
+    return boxes;
+}
+
 /// Rays that stress the node test lane by lane: axis-parallel with +-0 in
 /// the other components, from the faces of the tree's child boxes, and rays
 /// aimed at the corners of those boxes; neighbours share a box, so packets
 /// mix lanes that graze it with lanes that miss it.
 template <int N>
 std::vector<Rayf> adversarial_rays(const WideBvh<N, 8>& bvh, std::mt19937& rng, int n) {
-    std::vector<Box3f> boxes;
-    for (const WideNode<N>& node : bvh.nodes)
-        for (int i = 0; i < N; ++i)
-            if (node.child[i] != wide_child::kEmpty) boxes.push_back(node.box(i));
+    const std::vector<Box3f> boxes = child_boxes(bvh);
     std::vector<Rayf> rays;
     if (boxes.empty()) return rays;
     std::uniform_real_distribution<float> u(0, 1);
@@ -111,6 +122,40 @@ std::vector<Rayf> adversarial_rays(const WideBvh<N, 8>& bvh, std::mt19937& rng, 
             c.org = corner + random_direction(rng) * (1.0f + u(rng)) * length(b.extent());
             c.dir = corner - c.org;
             rays.push_back(c);
+        }
+    }
+    return rays;
+}
+
+/// Rays from one small box beyond the scene's low corner to the corners of
+/// the tree's child boxes and to points on their edges: every direction
+/// positive, so that packets form groups whose interval test (origins and
+/// reciprocals as intervals) meets boxes the rays only graze. Every third
+/// ray stops at its target, every third a little before it.
+template <int N>
+std::vector<Rayf> corner_fan(const WideBvh<N, 8>& bvh, const Scene& scene, std::mt19937& rng, int n) {
+    const std::vector<Box3f> boxes = child_boxes(bvh);
+    std::vector<Rayf> rays;
+    if (boxes.empty()) return rays;
+    const Box3f scene_box = scene_bounds(scene);
+    const Vec3f extent = scene_box.extent();
+    const Box3f origins{scene_box.lo - extent * 0.6f, scene_box.lo - extent * 0.5f};
+    std::uniform_real_distribution<float> u(0, 1);
+    // Neighbouring rays aim at the same box, so that a packet's lanes split on it.
+    for (int i = 0; int(rays.size()) < n; ++i) {
+        const Box3f& b = boxes[rng() % boxes.size()];
+        for (int k = 0; k < 8; ++k) {
+            Vec3f target{k & 1 ? b.hi.x : b.lo.x, k & 2 ? b.hi.y : b.lo.y, k & 4 ? b.hi.z : b.lo.z};
+            Rayf r;
+            r.org = i % 3 == 0 ? origins.lo : random_point(rng, origins);
+            if (i % 2) {
+                const int a = int(rng() % 3);
+                target[a] = b.lo[a] + u(rng) * (b.hi[a] - b.lo[a]);  // on an edge
+            }
+            r.dir = target - r.org;
+            if (k % 3 == 1) r.tfar = 1.0f;
+            if (k % 3 == 2) r.tfar = 0.999f;
+            rays.push_back(r);
         }
     }
     return rays;
@@ -173,11 +218,16 @@ void check_scene(const Scene& scene, const std::string& label) {
     const Box3f random_box = grown(scene_bounds(scene), 0.1f);
     sets.push_back({"random", random_rays_in(rng, random_box, length(random_box.extent()), big ? 503 : 1503)});
     sets.push_back({"adversarial", adversarial_rays(accel.bvh(), rng, big ? 300 : 1000)});
+    sets.push_back({"camera in tiles", camera_ray_set(scene, big ? 40 : 64, big ? 40 : 64, nullptr, PixelOrder::Tiles)});
+    sets.push_back({"corner fan", corner_fan(accel.bvh(), scene, rng, big ? 800 : 2400)});
+    sets.push_back({"corner fan occlusion", sets.back().rays, true});
     {
         const std::vector<Hitf> cam = trace(brute, 1, false, sets[0].rays);
         sets.push_back({"shadow", shadow_rays(scene, sets[0].rays, cam), true});
         RaySet occ{"random occlusion", sets[1].rays, true};
         sets.push_back(occ);
+        const std::vector<Hitf> tiled = trace(brute, 1, false, sets[3].rays);
+        sets.push_back({"shadow in tiles", shadow_rays(scene, sets[3].rays, tiled), true});
     }
     std::size_t shared = 0;
     for (const RaySet& set : sets) {
@@ -185,11 +235,18 @@ void check_scene(const Scene& scene, const std::string& label) {
         const std::vector<Hitf> single = trace(accel, 1, set.any_hit, set.rays);
         for (int k : {4, 8, 16}) {
             if (!accel.supports_packet(k)) continue;
-            for (int below : {0, default_wide_switch_below(N, k), k + 1}) {
-                accel.set_packet_config(k, WidePacketConfig{below});
+            const int fallback = default_wide_switch_below(N, k);
+            const std::pair<int, int> configs[] = {{0, 1}, {fallback, 1}, {k + 1, 1}, {fallback, 4}, {fallback, 16}, {0, 16}};
+            for (auto [below, group] : configs) {
+                WidePacketConfig c;
+                c.switch_below = below;
+                c.group_packets = group;
+                accel.set_packet_config(k, c);
                 SCOPED_TRACE(label + " bvh" + std::to_string(N) + " " + set.name + " K=" + std::to_string(k) +
-                             " switch_below=" + std::to_string(below));
-                const std::vector<Hitf> packet = trace(accel, k, set.any_hit, set.rays);
+                             " switch_below=" + std::to_string(below) + " group=" + std::to_string(group));
+                // Batches of several groups, with a ragged group at their end.
+                const std::vector<Hitf> packet =
+                    trace(accel, k, set.any_hit, set.rays, group == 1 ? 61 : std::size_t(group) * k * 3 - 5);
                 std::string first;
                 EXPECT_EQ(count_unlike_single(set, single, packet, first), 0u)
                     << "of " << set.rays.size() << " rays differ from the single-ray traversal" << first;
@@ -197,7 +254,7 @@ void check_scene(const Scene& scene, const std::string& label) {
                 EXPECT_EQ(count_unlike_oracle(set, truth, single, packet, shared, first), 0u)
                     << "of " << set.rays.size() << " rays differ from brute force" << first;
             }
-            accel.set_packet_config(k, WidePacketConfig{default_wide_switch_below(N, k)});
+            accel.set_packet_config(k, default_wide_packet_config(N, k));
         }
     }
     if (shared != 0)

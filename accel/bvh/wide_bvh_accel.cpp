@@ -37,6 +37,8 @@ WideBvhAccel<N, M, Test>::WideBvhAccel(const Scene& scene, const AccelConfig& co
     cc.triangle_layout = collapse_config(config).triangle_layout;  // must match the kernel that runs
     cc.objects = config.kernels.objects;
     bvh_ = collapse_bvh<N, M>(binary, scene, cc);
+    if (config.packet_group > 0)
+        for (WidePacketConfig& c : packet_config_) c.group_packets = config.packet_group;
     stats_.name = N == 4 ? "bvh4" : "bvh8";
     stats_.builder = config.builder;
     stats_.nodes = bvh_.nodes.size();

@@ -44,8 +44,8 @@ private:
     static constexpr bool kPackets = M == 8 && Test == NodeTest::Ordered;
     const Scene* scene_;  ///< --precision double tests leaves' primitives by id
     KernelChoice kernels_;
-    WidePacketConfig packet_config_[3] = {{default_wide_switch_below(N, 4)}, {default_wide_switch_below(N, 8)},
-                                          {default_wide_switch_below(N, 16)}};  ///< K = 4, 8, 16
+    WidePacketConfig packet_config_[3] = {default_wide_packet_config(N, 4), default_wide_packet_config(N, 8),
+                                          default_wide_packet_config(N, 16)};  ///< K = 4, 8, 16
     WideBvh<N, M> bvh_;
 };
 

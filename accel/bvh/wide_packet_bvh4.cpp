@@ -1,6 +1,6 @@
 // Packet traversal of the BVH4 (accel/bvh/wide_packet.h), one file per
 // tree width to keep compile times bounded.
-#include "accel/bvh/wide_packet_traversal.h"
+#include "accel/bvh/wide_group_traversal.h"
 
 namespace raypack {
 

@@ -384,34 +384,3 @@ void trace_packet(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, int swit
 }
 
 }  // namespace raypack::wide_packet_detail
-
-namespace raypack {
-
-template <int N, int M, int K, bool AnyHit>
-void wide_trace_packets(const WideBvh<N, M>& bvh, const Scene& scene, KernelChoice kernels,
-                        const WidePacketConfig& config, std::span<const Rayf> rays, std::span<Hitf> hits) {
-    if (bvh.nodes.empty()) {
-        for (auto& h : hits) h = Hitf{};
-        return;
-    }
-    const wide_packet_detail::PacketKernels<K> pk{kernels, {&scene, kernels}, {&scene, kernels}};
-    auto run = [&]<TriangleMethod TM, bool ByPrim, class Kinds = PrimKinds>() {
-        trace_in_packets<K, AnyHit>(rays, hits, kernels.rcp, [&](RayPacket<K>& ray, HitPacket<K>& hit,
-                                                                 vmask<K> valid, vmask<K>& occluded) {
-            wide_packet_detail::trace_packet<N, M, K, TM, AnyHit, ByPrim, Kinds>(bvh, pk, config.switch_below, ray,
-                                                                                 hit, valid, occluded);
-        });
-    };
-    // Double: leaves test primitives by id, so one instantiation serves every
-    // triangle method (as in WideBvhAccel::trace).
-    if (kernels.precision == Precision::Double) return run.template operator()<TriangleMethod::Moeller, true>();
-    if (specialisation_for(scene, kernels) == KindSpecialisation::Triangles)
-        return run.template operator()<TriangleMethod::Moeller, false, TriangleKinds>();
-    switch (kernels.triangle) {
-        case TriangleMethod::Moeller: return run.template operator()<TriangleMethod::Moeller, false>();
-        case TriangleMethod::Watertight: return run.template operator()<TriangleMethod::Watertight, false>();
-        case TriangleMethod::Plane: return run.template operator()<TriangleMethod::Plane, false>();
-    }
-}
-
-}  // namespace raypack

@@ -1,0 +1,315 @@
+#pragma once
+// Groups of packets sharing one walk of the wide BVH ("large packets": Wald,
+// Boulos, Shirley, "Ray Tracing Deformable Scenes Using Dynamic Bounding
+// Volume Hierarchies", ACM TOG 2007; the interval test after Boulos et al.,
+// "Geometric and Arithmetic Culling Methods for Entire Ray Packets", 2006),
+// included only by the .cpp files that instantiate the packet traversal.
+//
+// G packets of K rays walk the tree once. At an inner node the group's rays
+// as intervals (origins, reciprocals, tnear and tfar over every lane) reject
+// at once the children no ray can meet, for all N children in one SIMD test;
+// a child that survives is tested packet by packet from the group's first
+// active packet, and entered by the first packet some lane of which meets it
+// and every active packet after it ("first active": the packets before it
+// are known to miss it, those after it are not tested until they must be).
+// At a leaf each of those packets tests the leaf's box and then its
+// primitives, with the kernels and the per-lane tests of the single-packet
+// walk (wide_packet_traversal.h), so every (ray, primitive) pair gives the
+// same answer; as there, only which of two nearly coincident hits is kept
+// may differ from the single ray.
+//
+// The interval test is exact in floating point: a lane's near distance is
+// round(round(plane - o) * r), and rounding is monotone, so the smallest of
+// the four products of the extreme (plane - o) and r bounds every lane's
+// from below, and likewise the largest far distance from above. It needs
+// finite origins and reciprocals and one direction sign per axis over the
+// group; other groups trace packet by packet.
+#include <array>
+#include <bit>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+#include "accel/bvh/wide_packet_traversal.h"
+
+namespace raypack::wide_packet_detail {
+
+/// The group's rays as intervals, per axis: origins [o_lo, o_hi], near and
+/// far reciprocals [r_lo, r_hi] and [f_lo, f_hi], and the row of the node's
+/// near plane (0..2: lo, 3..5: hi).
+struct GroupIntervals {
+    float o_lo[3], o_hi[3], r_lo[3], r_hi[3], f_lo[3], f_hi[3];
+    int near_row[3];
+    float tnear_lo;
+};
+
+/// Whether the valid lanes of `count` packets share one direction sign per
+/// axis (a lane's sign is its reciprocal's, as the node test picks planes).
+template <int K>
+RAYPACK_INLINE bool one_octant(const LoadedPacket<K>* p, int count) {
+    using F = vfloat<K>;
+    const F zero(0.0f);
+    std::uint32_t neg_any = 0, neg_all = 7, valid_any = 0;
+    for (int q = 0; q < count; ++q) {
+        const std::uint32_t v = mask_bits(p[q].valid);
+        if (v == 0) continue;
+        valid_any = 1;
+        const std::uint32_t nx = mask_bits(p[q].ray.rdir.x < zero) & v, ny = mask_bits(p[q].ray.rdir.y < zero) & v,
+                            nz = mask_bits(p[q].ray.rdir.z < zero) & v;
+        neg_any |= (nx != 0 ? 1u : 0u) | (ny != 0 ? 2u : 0u) | (nz != 0 ? 4u : 0u);
+        neg_all &= (nx == v ? 1u : 0u) | (ny == v ? 2u : 0u) | (nz == v ? 4u : 0u);
+    }
+    return valid_any != 0 && neg_any == neg_all;
+}
+
+/// The intervals of `count` packets' valid lanes (one_octant holds); false
+/// if the test does not apply (a NaN or infinite origin or reciprocal). A
+/// lane with a NaN tnear meets no box and is left out.
+template <int K>
+inline bool group_intervals(const PacketNodeRay<K>* nr, const LoadedPacket<K>* p, int count, GroupIntervals& g) {
+    using F = vfloat<K>;
+    const F inf(std::numeric_limits<float>::infinity()), zero(0.0f);
+    F o_lo[3] = {inf, inf, inf}, o_hi[3] = {-inf, -inf, -inf}, r_lo[3] = {inf, inf, inf}, r_hi[3] = {-inf, -inf, -inf};
+    F f_lo[3] = {inf, inf, inf}, f_hi[3] = {-inf, -inf, -inf}, tnear_lo = inf;
+    F non_finite = zero;  // x - x is NaN for NaN and +-inf, 0 otherwise; sums keep the NaN
+    for (int q = 0; q < count; ++q) {
+        const vmask<K> v = p[q].valid;
+        for (int a = 0; a < 3; ++a) {
+            const F o = nr[q].org[a], r = nr[q].rdir[a], f = nr[q].rdir_far[a];
+            non_finite = non_finite + select(v, (o - o) + (r - r) + (f - f), zero);
+            o_lo[a] = vmin(o_lo[a], select(v, o, inf));
+            o_hi[a] = vmax(o_hi[a], select(v, o, -inf));
+            r_lo[a] = vmin(r_lo[a], select(v, r, inf));
+            r_hi[a] = vmax(r_hi[a], select(v, r, -inf));
+            f_lo[a] = vmin(f_lo[a], select(v, f, inf));
+            f_hi[a] = vmax(f_hi[a], select(v, f, -inf));
+        }
+        tnear_lo = vmin(tnear_lo, select(v, nr[q].tnear, inf));
+    }
+    if (any(non_finite != non_finite)) return false;
+    for (int a = 0; a < 3; ++a) {
+        g.o_lo[a] = lane_min<K>(o_lo[a]);
+        g.o_hi[a] = lane_max<K>(o_hi[a]);
+        g.r_lo[a] = lane_min<K>(r_lo[a]);
+        g.r_hi[a] = lane_max<K>(r_hi[a]);
+        g.f_lo[a] = lane_min<K>(f_lo[a]);
+        g.f_hi[a] = lane_max<K>(f_hi[a]);
+        g.near_row[a] = g.r_hi[a] < 0.0f ? a + 3 : a;
+    }
+    g.tnear_lo = lane_min<K>(tnear_lo);
+    return true;
+}
+
+/// Children of `node` some ray of the group may meet before `tfar_hi` (the
+/// largest widened tfar of its lanes), as bits; `entry` gets each child's
+/// lower bound on the entry distance (the order key).
+template <int N>
+RAYPACK_INLINE std::uint32_t group_child_candidates(const WideNode<N>& node, const GroupIntervals& g, float tfar_hi,
+                                                    vfloat<N>& entry) {
+    using V = vfloat<N>;
+    V enter(g.tnear_lo), leave(tfar_hi);
+    for (int a = 0; a < 3; ++a) {
+        const V near_plane = V::load_aligned(node.bounds[g.near_row[a]]);
+        const V far_plane = V::load_aligned(node.bounds[g.near_row[a] < 3 ? a + 3 : a]);
+        // plane - o is largest at o_lo and smallest at o_hi.
+        const V n0 = near_plane - V(g.o_hi[a]), n1 = near_plane - V(g.o_lo[a]);
+        const V f0 = far_plane - V(g.o_hi[a]), f1 = far_plane - V(g.o_lo[a]);
+        const V r0(g.r_lo[a]), r1(g.r_hi[a]), s0(g.f_lo[a]), s1(g.f_hi[a]);
+        const V near_lo = vmin(vmin(n0 * r0, n0 * r1), vmin(n1 * r0, n1 * r1));
+        const V far_hi = vmax(vmax(f0 * s0, f0 * s1), vmax(f1 * s0, f1 * s1));
+        enter = vmax(enter, near_lo);
+        leave = vmin(leave, far_hi);
+    }
+    entry = enter;
+    // An empty slot (lo = +inf, hi = -inf) gives enter = +inf or NaN: not <=.
+    return mask_bits(enter <= leave);
+}
+
+/// The largest of the packets' tfar bounds `packet_tfar_hi` over `packets`.
+RAYPACK_INLINE float group_tfar_hi(const float* packet_tfar_hi, std::uint32_t packets) {
+    float t = -std::numeric_limits<float>::infinity();
+    for (; packets != 0; packets &= packets - 1) t = vmax(t, packet_tfar_hi[std::countr_zero(packets)]);
+    return t;
+}
+
+/// The walk's state of each of the first `count` packets (the rest unused).
+template <int K, int G, std::size_t... I>
+RAYPACK_INLINE std::array<PacketState<K>, G> packet_states(LoadedPacket<K>* p, int count, std::index_sequence<I...>) {
+    const vfloat<K> zero(0.0f);
+    return {PacketState<K>{p[I].hit, int(I) < count ? p[I].ray.tfar : zero, p[I].valid, p[I].occluded}...};
+}
+template <int K, int G>
+RAYPACK_INLINE std::array<PacketState<K>, G> packet_states(LoadedPacket<K>* p, int count) {
+    return packet_states<K, G>(p, count, std::make_index_sequence<G>());
+}
+
+/// `count` packets (count <= G <= 32) through the tree together.
+template <int N, int M, int K, int G, TriangleMethod TM, bool AnyHit, bool ByPrim, class Kinds>
+void trace_group(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, int switch_below, LoadedPacket<K>* p,
+                 int count) {
+    using F = vfloat<K>;
+    PacketNodeRay<K> nr[G];
+    const bool together = count > 1 && one_octant<K>(p, count);
+    if (together)
+        for (int q = 0; q < count; ++q) nr[q] = make_packet_node_ray<K>(p[q].ray, pk.kernels.slabs);
+    GroupIntervals g;
+    if (!together || !group_intervals<K>(nr, p, count, g)) {
+        for (int q = 0; q < count; ++q)
+            trace_packet<N, M, K, TM, AnyHit, ByPrim, Kinds>(bvh, pk, switch_below, p[q].ray, p[q].hit, p[q].valid,
+                                                             p[q].occluded);
+        return;
+    }
+    const SphereMethod sm = pk.kernels.sphere;
+    const F minus_inf(-std::numeric_limits<float>::infinity());
+    LeafRay<F> lr[G];
+    auto s = packet_states<K, G>(p, count);
+    float tfar_hi[G];  // per packet: the largest widened tfar of its valid lanes
+    std::uint32_t live = 0;
+    for (int q = 0; q < count; ++q) {
+        if constexpr (!ByPrim) lr[q] = make_packet_leaf_ray<K>(p[q].ray, TM);
+        tfar_hi[q] = lane_max<K>(select(s[q].valid, node_tfar(s[q].tfar), minus_inf));
+        if (any(p[q].valid)) live |= 1u << q;
+    }
+    // The group's bound on tfar for the interval test: over every packet
+    // still traced, renewed after each leaf.
+    float tfar_group = group_tfar_hi(tfar_hi, live);
+    const WideNode<N>* nodes = bvh.nodes.data();
+    // Stack entries: a child, the packets that enter it, and where its box is
+    // (parent node and slot), for the leaves' per-packet box tests.
+    constexpr int kStackSize = (N - 1) * kBvhMaxDepth + 1;
+    std::uint32_t stack_code[kStackSize], stack_packets[kStackSize], stack_parent[kStackSize];
+    int stack_slot[kStackSize];
+    float stack_entry[kStackSize];
+    int sp = 0;
+    std::uint32_t cur = 0, cur_packets = live, parent = 0;
+    int slot = 0;
+    for (;;) {
+        if (wide_child::is_leaf(cur)) {
+            const WideNode<N>& box_node = nodes[parent];
+            for (std::uint32_t bits = cur_packets; bits != 0; bits &= bits - 1) {
+                const int q = std::countr_zero(bits);
+                F e;
+                const vmask<K> m = child_hits<N, K>(box_node, slot, nr[q], s[q].valid, node_tfar(s[q].tfar), e);
+                if (none(m)) continue;
+                if constexpr (ByPrim) packet_leaf_by_prim<AnyHit>(bvh, pk.packet, cur, p[q].ray, m, s[q]);
+                else packet_leaf<TM, AnyHit, Kinds>(bvh, sm, cur, lr[q], m, s[q]);
+                tfar_hi[q] = lane_max<K>(select(s[q].valid, node_tfar(s[q].tfar), minus_inf));
+                if constexpr (AnyHit)
+                    if (none(s[q].valid)) live &= ~(1u << q);
+            }
+            if constexpr (AnyHit)
+                if (live == 0) return;
+            tfar_group = group_tfar_hi(tfar_hi, live);
+        } else {
+            const WideNode<N>& node = nodes[cur];
+            vfloat<N> entry_v;
+            std::uint32_t candidates =
+                group_child_candidates<N>(node, g, tfar_group, entry_v);
+            alignas(64) float entry[N];
+            entry_v.store_aligned(entry);
+            std::uint32_t child_packets[N];
+            int hit_slot[N], n_hit = 0;
+            for (; candidates != 0; candidates &= candidates - 1) {
+                const int i = std::countr_zero(candidates);
+                // The first and the last packet that meet child i, and those between.
+                std::uint32_t bits = cur_packets;
+                for (; bits != 0; bits &= bits - 1) {
+                    const int q = std::countr_zero(bits);
+                    F e;
+                    if (any(child_hits<N, K>(node, i, nr[q], s[q].valid, node_tfar(s[q].tfar), e))) break;
+                }
+                if (bits == 0) continue;
+                for (std::uint32_t rest = bits & (bits - 1); rest != 0;) {
+                    const int q = 31 - std::countl_zero(rest);
+                    F e;
+                    if (any(child_hits<N, K>(node, i, nr[q], s[q].valid, node_tfar(s[q].tfar), e))) break;
+                    rest &= ~(1u << q);
+                    bits &= ~(1u << q);
+                }
+                child_packets[n_hit] = bits;
+                hit_slot[n_hit++] = i;
+            }
+            if (n_hit != 0) {
+                // Nearest first by the group's entry bound; push the others farthest first.
+                int order[N];
+                for (int c = 0; c < n_hit; ++c) {
+                    int at = c;
+                    if constexpr (!AnyHit)
+                        for (; at > 0 && entry[hit_slot[order[at - 1]]] > entry[hit_slot[c]]; --at) order[at] = order[at - 1];
+                    order[at] = c;
+                }
+                for (int c = n_hit - 1; c > 0; --c) {
+                    const int i = hit_slot[order[c]];
+                    stack_code[sp] = node.child[i];
+                    stack_packets[sp] = child_packets[order[c]];
+                    stack_parent[sp] = cur;
+                    stack_slot[sp] = i;
+                    stack_entry[sp++] = entry[i];
+                }
+                parent = cur;
+                slot = hit_slot[order[0]];
+                cur_packets = child_packets[order[0]];
+                cur = node.child[slot];
+                continue;
+            }
+        }
+        // Pop the next child the group may still meet before its closest hits.
+        for (;;) {
+            if (sp == 0) return;
+            --sp;
+            cur_packets = stack_packets[sp] & live;
+            if (cur_packets != 0 && !(stack_entry[sp] > tfar_group)) break;
+        }
+        cur = stack_code[sp];
+        parent = stack_parent[sp];
+        slot = stack_slot[sp];
+    }
+}
+
+}  // namespace raypack::wide_packet_detail
+
+namespace raypack {
+
+template <int N, int M, int K, bool AnyHit>
+void wide_trace_packets(const WideBvh<N, M>& bvh, const Scene& scene, KernelChoice kernels,
+                        const WidePacketConfig& config, std::span<const Rayf> rays, std::span<Hitf> hits) {
+    if (bvh.nodes.empty()) {
+        for (auto& h : hits) h = Hitf{};
+        return;
+    }
+    const wide_packet_detail::PacketKernels<K> pk{kernels, {&scene, kernels}, {&scene, kernels}};
+    auto run = [&]<TriangleMethod TM, bool ByPrim, class Kinds = PrimKinds>() {
+        auto trace_packet = [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid, vmask<K>& occluded) {
+            wide_packet_detail::trace_packet<N, M, K, TM, AnyHit, ByPrim, Kinds>(bvh, pk, config.switch_below, ray, hit,
+                                                                                 valid, occluded);
+        };
+        if (config.group_packets > 1) {
+            constexpr int G = WidePacketConfig::kMaxGroupPackets;
+            const int group = std::min(config.group_packets, G);
+            // trace_in_groups takes its group size at compile time; a smaller
+            // configured group is cut from the loaded one.
+            trace_in_groups<K, G, AnyHit>(
+                rays, hits, kernels.rcp,
+                [](const LoadedPacket<K>& p) { return wide_packet_detail::one_octant<K>(&p, 1); }, trace_packet,
+                [&](LoadedPacket<K>* p, int count) {
+                    for (int first = 0; first < count; first += group)
+                        wide_packet_detail::trace_group<N, M, K, G, TM, AnyHit, ByPrim, Kinds>(
+                            bvh, pk, config.switch_below, p + first, std::min(group, count - first));
+                });
+            return;
+        }
+        trace_in_packets<K, AnyHit>(rays, hits, kernels.rcp, trace_packet);
+    };
+    // Double: leaves test primitives by id, so one instantiation serves every
+    // triangle method (as in WideBvhAccel::trace).
+    if (kernels.precision == Precision::Double) return run.template operator()<TriangleMethod::Moeller, true>();
+    if (specialisation_for(scene, kernels) == KindSpecialisation::Triangles)
+        return run.template operator()<TriangleMethod::Moeller, false, TriangleKinds>();
+    switch (kernels.triangle) {
+        case TriangleMethod::Moeller: return run.template operator()<TriangleMethod::Moeller, false>();
+        case TriangleMethod::Watertight: return run.template operator()<TriangleMethod::Watertight, false>();
+        case TriangleMethod::Plane: return run.template operator()<TriangleMethod::Plane, false>();
+    }
+}
+
+}  // namespace raypack
