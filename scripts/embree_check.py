@@ -13,6 +13,7 @@ scene and ray kind; the table gives medians over the rounds (docs/embree.md).
 
 usage: scripts/embree_check.py [--rounds N] [--res N] [--repeat R] [--build DIR]
                                [--scenes a,b] [--kinds camera,shadow,diffuse] [--threads T]
+                               [--order tiles|rows]
 
 --scenes takes the names below or any scene raypack loads (a file or
 gen:NAME:SIZE), e.g. --scenes gen:tetra:10 for a million triangles.
@@ -76,6 +77,8 @@ def main():
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
     ap.add_argument("--scenes", default="bunny,tetra,balls")
     ap.add_argument("--kinds", default="camera,shadow,diffuse")
+    ap.add_argument("--order", choices=["tiles", "rows"], default="tiles",
+                    help="pixel order of the ray sets (raypack rays --order; docs/rays.md)")
     ap.add_argument("--threads", type=int, default=1,
                     help="threads for the backend and raypack; embree_direct runs one thread, so above 1 it is left out")
     args = ap.parse_args()
@@ -91,7 +94,7 @@ def main():
             for k in kinds:
                 files[s, k] = os.path.join(tmp, f"{os.path.basename(s).replace(':', '_')}-{k}.rays")
                 run([os.path.join(args.build, "raypack"), "rays", SCENES.get(s, s), "--kind", k, "--res", str(args.res),
-                     str(args.res), "-o", files[s, k]])
+                     str(args.res), "--order", args.order, "-o", files[s, k]])
         for r in range(args.rounds):
             for s in scenes:
                 for k in kinds:

@@ -139,7 +139,8 @@ std::vector<Rayf> corner_fan(const WideBvh<N, 8>& bvh, const Scene& scene, std::
     if (boxes.empty()) return rays;
     const Box3f scene_box = scene_bounds(scene);
     const Vec3f extent = scene_box.extent();
-    const Box3f origins{scene_box.lo - extent * 0.6f, scene_box.lo - extent * 0.5f};
+    // Within the spread a group may have (a sixteenth of the scene, max_origin_spread).
+    const Box3f origins{scene_box.lo - extent * 0.52f, scene_box.lo - extent * 0.5f};
     std::uniform_real_distribution<float> u(0, 1);
     // Neighbouring rays aim at the same box, so that a packet's lanes split on it.
     for (int i = 0; int(rays.size()) < n; ++i) {
