@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include "kernels/simd.h"
 #include <sstream>
 
 #include "scene/ray_file.h"
@@ -226,8 +227,10 @@ TEST(Cli, TraceDefaultsToTheFastestConfigurationForTheRays) {
         const char* accel;
         int packet;
     };
-    for (const Case& c : {Case{"camera", "camera", "bvh4", 16}, Case{"shadow", "shadow", "bvh8", 16},
-                          Case{"diffuse", "diffuse", "bvh4", 16}}) {
+    // Without AVX-512: packets of 8, and diffuse rays one at a time through the BVH8.
+    constexpr bool wide = kWidthCompiled<16>;
+    for (const Case& c : {Case{"camera", "camera", "bvh4", wide ? 16 : 8}, Case{"shadow", "shadow", "bvh8", wide ? 16 : 8},
+                          Case{"diffuse", "diffuse", wide ? "bvh4" : "bvh8", wide ? 16 : 1}}) {
         const std::string rays = (dir / (std::string("default_") + c.kind + ".rays")).string();
         ASSERT_EQ(run("rays " + scene + " --kind " + c.kind + " --res 32 32 -o " + rays).status, 0);
         const Result r = run("trace " + scene + " --rays " + rays + " --repeat 1 --json");
@@ -236,16 +239,27 @@ TEST(Cli, TraceDefaultsToTheFastestConfigurationForTheRays) {
         EXPECT_TRUE(j["default_config"].get<bool>()) << c.kind;
         EXPECT_EQ(j["workload"], c.workload);
         EXPECT_EQ(j["accel"], c.accel) << c.kind;
-#if defined(__AVX512BW__)
         EXPECT_EQ(j["packet"].get<int>(), c.packet) << c.kind;
-#endif
+        // Packets walk in groups of 128 rays (accel/bvh/wide_packet.h); single rays alone.
+        EXPECT_EQ(j["group"].get<int>(), c.packet > 1 ? 128 / c.packet : 1) << c.kind;
         const Result named = run("trace " + scene + " --rays " + rays + " --repeat 1 --json --accel bvh2");
         ASSERT_EQ(named.status, 0) << named.output;
         const auto jn = nlohmann::json::parse(named.output);
         EXPECT_FALSE(jn["default_config"].get<bool>());
         EXPECT_EQ(jn["accel"], "bvh2");
         EXPECT_EQ(jn["packet"].get<int>(), 1);
+        EXPECT_EQ(jn["group"].get<int>(), 1);
     }
+    // --group names the group size and keeps the default structure; it is
+    // refused for a structure that has no groups.
+    const std::string rays = (dir / "default_camera.rays").string();
+    const Result g = run("trace " + scene + " --rays " + rays + " --repeat 1 --json --group 2");
+    ASSERT_EQ(g.status, 0) << g.output;
+    const auto jg = nlohmann::json::parse(g.output);
+    EXPECT_TRUE(jg["default_config"].get<bool>());
+    EXPECT_EQ(jg["group"].get<int>(), 2);
+    EXPECT_EQ(run("trace " + scene + " --rays " + rays + " --group 2 --accel grid --packet 8").status, 2);
+    EXPECT_EQ(run("trace " + scene + " --rays " + rays + " --group 17").status, 2);
 }
 
 TEST(Cli, BadFlagsAreUsageErrors) {
