@@ -226,8 +226,7 @@ void trace_group(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, int switc
         } else {
             const WideNode<N>& node = nodes[cur];
             vfloat<N> entry_v;
-            std::uint32_t candidates =
-                group_child_candidates<N>(node, g, tfar_group, entry_v);
+            std::uint32_t candidates = group_child_candidates<N>(node, g, tfar_group, entry_v);
             alignas(64) float entry[N];
             entry_v.store_aligned(entry);
             std::uint32_t child_packets[N];
@@ -292,6 +291,7 @@ void trace_group(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, int switc
 }  // namespace raypack::wide_packet_detail
 
 namespace raypack {
+
 template <int N, int M, int K, bool AnyHit>
 void wide_trace_packets(const WideBvh<N, M>& bvh, const Scene& scene, KernelChoice kernels,
                         const WidePacketConfig& config, std::span<const Rayf> rays, std::span<Hitf> hits) {
