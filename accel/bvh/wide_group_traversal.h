@@ -155,11 +155,12 @@ RAYPACK_INLINE float group_tfar_hi(const float* packet_tfar_hi, std::uint32_t pa
     return t;
 }
 
-/// The walk's state of each of the first `count` packets (the rest unused).
+/// The walk's state of each of the first `count` packets; the entries past
+/// them (never used) refer to the first packet, as `p` may hold only `count`.
 template <int K, int G, std::size_t... I>
 RAYPACK_INLINE std::array<PacketState<K>, G> packet_states(LoadedPacket<K>* p, int count, std::index_sequence<I...>) {
-    const vfloat<K> zero(0.0f);
-    return {PacketState<K>{p[I].hit, int(I) < count ? p[I].ray.tfar : zero, p[I].valid, p[I].occluded}...};
+    auto at = [&](std::size_t i) -> LoadedPacket<K>& { return int(i) < count ? p[i] : p[0]; };
+    return {PacketState<K>{at(I).hit, at(I).ray.tfar, at(I).valid, at(I).occluded}...};
 }
 template <int K, int G>
 RAYPACK_INLINE std::array<PacketState<K>, G> packet_states(LoadedPacket<K>* p, int count) {
