@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include "tests/test_paths.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -160,16 +161,75 @@ TEST(Triangulate, TriangleIsItself) {
     EXPECT_EQ(tri({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}), (Tris{{0, 1, 2}}));
 }
 
-TEST(Triangulate, ConvexPolygonsAreFans) {
+TEST(Triangulate, ConvexQuadrilateralsAreFans) {
     EXPECT_EQ(tri(xy({{0, 0}, {1, 0}, {1, 1}, {0, 1}})), (Tris{{0, 1, 2}, {0, 2, 3}}));
     EXPECT_EQ(tri(reversed(xy({{0, 0}, {1, 0}, {1, 1}, {0, 1}}))), (Tris{{0, 1, 2}, {0, 2, 3}}));
+}
+
+TEST(Triangulate, LargerConvexPolygonsAreCutInPasses) {
+    // The hexagon: every other corner in the first pass, then the middle.
     std::vector<Vec3f> hex;
     for (int i = 0; i < 6; ++i) hex.push_back({float(std::cos(i * 1.0472)), float(std::sin(i * 1.0472)), 0});
-    const Tris expected{{0, 1, 2}, {0, 2, 3}, {0, 3, 4}, {0, 4, 5}};
+    const Tris expected{{5, 0, 1}, {1, 2, 3}, {3, 4, 5}, {1, 3, 5}};
     EXPECT_EQ(tri(rotated(hex)), expected);
+    expect_tiles(rotated(hex), tri(rotated(hex)), 1e-6);
     // Collinear points on the edges do not make a polygon concave.
     EXPECT_EQ(tri(xy({{0, 0}, {1, 0}, {2, 0}, {2, 1}, {1, 1}, {0, 1}})).size(), 4u);
     expect_tiles(xy({{0, 0}, {1, 0}, {2, 0}, {2, 1}, {1, 1}, {0, 1}}), tri(xy({{0, 0}, {1, 0}, {2, 0}, {2, 1}, {1, 1}, {0, 1}})), 1e-12);
+}
+
+namespace {
+
+/// The most triangles that share one vertex.
+std::size_t max_valence(const Tris& tris, std::size_t n) {
+    std::vector<std::size_t> count(n);
+    for (const auto& t : tris)
+        for (std::uint32_t i : t) ++count[i];
+    return *std::max_element(count.begin(), count.end());
+}
+
+/// The triangles' axis-aligned boxes' summed areas in the polygon's plane,
+/// over the polygon's area: what a BVH over them pays (a fan of slivers
+/// from one vertex: tens of times the polygon).
+double box_cover(const std::vector<Vec3f>& v, const Tris& tris) {
+    const Vec3d n = raypack::normalize(newell(v));
+    const Vec3d e1 = raypack::normalize(raypack::cross(std::abs(n.x) < 0.9 ? Vec3d{1, 0, 0} : Vec3d{0, 1, 0}, n));
+    const Vec3d e2 = raypack::cross(n, e1);
+    double sum = 0;
+    for (const auto& t : tris) {
+        double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+        for (std::uint32_t i : t) {
+            const double c[2] = {raypack::dot(Vec3d(v[i]), e1), raypack::dot(Vec3d(v[i]), e2)};
+            for (int a = 0; a < 2; ++a) lo[a] = std::min(lo[a], c[a]), hi[a] = std::max(hi[a], c[a]);
+        }
+        sum += (hi[0] - lo[0]) * (hi[1] - lo[1]);
+    }
+    return sum / polygon_area(v);
+}
+
+Tris fan_of(std::size_t n) {
+    Tris f;
+    for (std::uint32_t i = 1; i + 1 < n; ++i) f.push_back({0, i, i + 1});
+    return f;
+}
+
+}  // namespace
+
+TEST(Triangulate, ManySidedPolygonsGetCompactTrianglesNotSlivers) {
+    // A regular 64-gon, a 61-gon (odd passes) and a toothed disc like gears'.
+    for (int n : {64, 61}) {
+        SCOPED_TRACE(n);
+        std::vector<Vec3f> v;
+        for (int i = 0; i < n; ++i)
+            v.push_back({float(std::cos(2 * std::numbers::pi * i / n)), float(std::sin(2 * std::numbers::pi * i / n)), 0});
+        v = rotated(v);
+        const Tris t = tri(v);
+        expect_tiles(v, t, 1e-5);
+        // Passes: a vertex survives at most log2(n) of them, two triangles each.
+        EXPECT_LE(max_valence(t, v.size()), 2 * std::size_t(std::ceil(std::log2(n))) + 1);
+        EXPECT_LT(box_cover(v, t), 4.0);
+        EXPECT_GT(box_cover(v, fan_of(v.size())), 8.0) << "the bound would not rule out the fan";
+    }
 }
 
 TEST(Triangulate, TrianglesKeepThePolygonsWinding) {
@@ -324,7 +384,13 @@ TEST(Triangulate, GearsConcave144GonsTileExactlyAndTheFanDoesNot) {
         SCOPED_TRACE("144-gon " + std::to_string(i));
         const auto& v = polys[i];
         const double area = polygon_area(v);
-        expect_tiles(v, tri(v), 1e-5);
+        const Tris t = tri(v);
+        expect_tiles(v, t, 1e-5);
+        // In passes: the teeth, then the disc inside them halved pass by
+        // pass (clipping toward the neighbour first made 70 slivers from one
+        // vertex: their boxes covered 30 times the polygon).
+        EXPECT_LT(box_cover(v, t), 4.0);
+        EXPECT_LE(max_valence(t, v.size()), 16u);
         // The fan: its signed areas sum to the polygon's (shoelace), but some
         // of its triangles are inverted, so the unsigned sum is too large.
         const Vec3d n = raypack::normalize(newell(v));
