@@ -112,6 +112,9 @@ struct Scratch {
     ShadowBatch shadows;
     ShadingPoints points;
     std::vector<SpawnPoint> spawn;
+    /// Transmitting points of the level (shading point, link) whose
+    /// refraction rays follow all the level's reflection rays.
+    std::vector<std::pair<std::size_t, std::size_t>> refracting;
     std::vector<PixelXY> pixels;
     CameraSampleBatch camera;           ///< distribution: the batch's camera samples
     std::vector<Sampler::Draw> draws;   ///< points on area lights: the level's draws (Sampler::get_many)
@@ -280,8 +283,14 @@ private:
                                      n_light, intensity_, facing_point, offset_, s.shadows.per_light[bucket]);
             }
         }
-        if (depth < options_.max_depth)
-            for (std::size_t j = 0; j < s.points.size(); ++j) spawn_children(j, depth, s);
+        if (depth < options_.max_depth) {
+            // All reflection rays of the level, then all refraction rays: a
+            // point's two children go opposite ways, so interleaved they
+            // would make every packet of the next level incoherent.
+            s.refracting.clear();
+            for (std::size_t j = 0; j < s.points.size(); ++j) spawn_reflection(j, depth, s);
+            for (const auto& [j, link] : s.refracting) spawn_refraction(j, link, s);
+        }
         trace_shadows(s);
     }
 
@@ -435,8 +444,9 @@ private:
         }
     }
 
-    /// The reflection and refraction rays of shading point j (SPD protocol).
-    void spawn_children(std::size_t j, int depth, Scratch& s) const {
+    /// The reflection ray of shading point j (SPD protocol), and its link;
+    /// a transmitting point is queued for spawn_refraction.
+    void spawn_reflection(std::size_t j, int depth, Scratch& s) const {
         RayTree& tree = s.tree;
         const ShadingPoints& pts = s.points;
         const std::int32_t i = pts.ray(j);
@@ -468,20 +478,31 @@ private:
         spawn_ray(pts.above(j), reflected_dir, offset_, tree.rays[std::size_t(link.reflect)]);
         if (m.transmittance > 0) {
             link.kt = m.transmittance;
-            // Snell's law; entering when the ray meets the outward side.
-            const float eta = sp.front ? 1.0f / m.ior : m.ior;
-            const float cos_i = -dot(view, ns);
-            const float k = 1.0f - eta * eta * (1.0f - cos_i * cos_i);
-            if (k >= 0) {
-                ++s.stats.refract_rays;
-                const Vec3f dir = view * eta + ns * (eta * cos_i - std::sqrt(k));
-                const std::int32_t child = tree.add();
-                tree.sample[std::size_t(child)] = tree.sample[std::size_t(i)];
-                tree.time[std::size_t(child)] = tree.time[std::size_t(i)];
-                spawn_ray(offset_.offset(sp.p, -ng), dir, offset_, tree.rays[std::size_t(child)]);
-                link.refract = child;
-            }
+            s.refracting.emplace_back(j, tree.links.size() - 1);
         }
+    }
+
+    /// The refraction ray of transmitting shading point j, unless total
+    /// internal reflection occurs (Snell's law; entering when the ray met
+    /// the outward side).
+    void spawn_refraction(std::size_t j, std::size_t link, Scratch& s) const {
+        RayTree& tree = s.tree;
+        const ShadingPoints& pts = s.points;
+        const std::int32_t i = pts.ray(j);
+        const SpawnPoint& sp = s.spawn[j];
+        const Material& m = scene_.materials[sp.material];
+        const Vec3f view = pts.view(j), ns = pts.shading_normal(j), ng = pts.geometric_normal(j);
+        const float eta = sp.front ? 1.0f / m.ior : m.ior;
+        const float cos_i = -dot(view, ns);
+        const float k = 1.0f - eta * eta * (1.0f - cos_i * cos_i);
+        if (!(k >= 0)) return;
+        ++s.stats.refract_rays;
+        const Vec3f dir = view * eta + ns * (eta * cos_i - std::sqrt(k));
+        const std::int32_t child = tree.add();
+        tree.sample[std::size_t(child)] = tree.sample[std::size_t(i)];
+        tree.time[std::size_t(child)] = tree.time[std::size_t(i)];
+        spawn_ray(offset_.offset(sp.p, -ng), dir, offset_, tree.rays[std::size_t(child)]);
+        tree.links[link].refract = child;
     }
 
     /// A cos at or below which phong_power(cos, shine) is exactly +0: it is
