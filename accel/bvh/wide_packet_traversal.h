@@ -144,15 +144,22 @@ struct PacketState {
 };
 
 /// A run of blocks of kind Kind against the active lanes, one primitive at
-/// a time (padding lanes, prim = kNoPrim, end a block).
-template <class Kind, TriangleMethod TM, bool AnyHit, int K, class Block>
+/// a time (padding lanes, prim = kNoPrim, end a block). Masked: only the
+/// primitives whose bits are set in slots[k] for the run's block k (a group
+/// of packets leaves out those none of its rays can meet,
+/// wide_group_traversal.h); the others are tested in the same order.
+template <class Kind, TriangleMethod TM, bool AnyHit, bool Masked = false, int K, class Block>
 RAYPACK_INLINE void packet_run(const Block* b, std::uint32_t count, SphereMethod sm, const LeafRay<vfloat<K>>& r,
-                               vmask<K> active, PacketState<K>& s) {
+                               vmask<K> active, PacketState<K>& s, const std::uint32_t* slots = nullptr) {
     using F = vfloat<K>;
     constexpr int M = int(sizeof(b->prim) / sizeof(b->prim[0]));
     F minus_inf(-std::numeric_limits<float>::infinity());
     for (; count != 0; --count, ++b) {
+        [[maybe_unused]] std::uint32_t todo = 0;
+        if constexpr (Masked) todo = *slots++;
         for (int j = 0; j < M && b->prim[j] != kNoPrim; ++j) {
+            if constexpr (Masked)
+                if (!((todo >> j) & 1u)) continue;
             F t(0.0f), u(0.0f), v(0.0f);  // the kernels set only their hit lanes
             [[maybe_unused]] std::uint32_t ids[names_hits<Kind> ? K : 1];
             vmask<K> m;
@@ -182,11 +189,15 @@ RAYPACK_INLINE void packet_run(const Block* b, std::uint32_t count, SphereMethod
 
 /// The blocks of one leaf against the active lanes (any hit: each run
 /// against the lanes not yet occluded).
-template <TriangleMethod TM, bool AnyHit, class Kinds, int N, int M, int K>
+/// Masked: `slots` holds a mask per block, in the order of the leaf's runs
+/// (packet_run).
+template <TriangleMethod TM, bool AnyHit, class Kinds, bool Masked = false, int N, int M, int K>
 RAYPACK_INLINE void packet_leaf(const WideBvh<N, M>& bvh, SphereMethod sm, std::uint32_t code,
-                                const LeafRay<vfloat<K>>& r, const vmask<K>& active, PacketState<K>& s) {
+                                const LeafRay<vfloat<K>>& r, const vmask<K>& active, PacketState<K>& s,
+                                const std::uint32_t* slots = nullptr) {
     bvh.template for_each_run<false, Kinds>(code, [&]<class Kind>(const auto* blocks, std::uint32_t n) RAYPACK_INLINE_LAMBDA {
-        packet_run<Kind, TM, AnyHit>(blocks, n, sm, r, AnyHit ? active & s.valid : active, s);
+        packet_run<Kind, TM, AnyHit, Masked>(blocks, n, sm, r, AnyHit ? active & s.valid : active, s, slots);
+        if constexpr (Masked) slots += n;
         return false;
     });
 }
