@@ -197,16 +197,23 @@ int run_render(const Args& args) {
     options.height = int(p.integer("--res", scene.camera.height, 1, 65536, 1));
     if (std::uint64_t(options.width) * std::uint64_t(options.height) > (1ull << 28))
         throw UsageError("--res: image of more than 2^28 pixels");
-    // The image, and the film of a sampled render: 12 bytes a pixel each, plus the counts.
-    require_memory(std::uint64_t(options.width) * std::uint64_t(options.height) * (options.distribution ? 28 : 12),
+    // The image (12 bytes a pixel) and the film of a sampled render (sums,
+    // sums of squares and counts: 28 bytes a pixel).
+    require_memory(std::uint64_t(options.width) * std::uint64_t(options.height) * (options.distribution ? 40 : 12),
                    "a " + std::to_string(options.width) + " x " + std::to_string(options.height) + " image");
 
-    // The image a Whitted render writes pixel by pixel, made before the
-    // build: its fresh pages cost several ms to fault in on this project's
-    // virtual machines, which is not rendering (render_ms), and which the
-    // second thread cannot share (docs/renderer.md, "Threads").
+    // The image, and the film a sampled render adds its samples to, made
+    // before the build: their fresh pages cost several ms to fault in on
+    // this project's virtual machines (tens of ms when the kernel clears
+    // huge pages), which is not rendering (render_ms), and which the second
+    // thread cannot share (docs/renderer.md, "Threads").
     Image image;
-    if (integrator == "whitted" && aov != "cost") image = Image(options.width, options.height);
+    std::optional<Film> film;
+    if (aov != "cost") {
+        image = Image(options.width, options.height);
+        if (integrator == "path" || (options.distribution && options.adaptive_threshold == 0 && options.spp > 1))
+            options.film = &film.emplace(options.width, options.height);
+    }
     const auto built = build_accel(scene, config);
     if (aov == "cost") return render_cost(scene, *built, options.width, options.height, output);
     // --counts: the render's queries through the counting walk, summed.

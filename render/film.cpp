@@ -46,13 +46,18 @@ Sample2 shaped_filter_offset(PixelFilter filter, Sample2 u) {
 }
 
 Image Film::resolve() const {
-    Image out(sum_.width, sum_.height);
+    Image out;
+    resolve(out);
+    return out;
+}
+
+void Film::resolve(Image& out) const {
+    if (out.width != sum_.width || out.height != sum_.height) out = Image(sum_.width, sum_.height);
     for (int y = 0; y < sum_.height; ++y)
         for (int x = 0; x < sum_.width; ++x) {
             const int n = count_[std::size_t(y) * std::size_t(sum_.width) + std::size_t(x)];
             out.set(x, y, n > 0 ? sum_.at(x, y) / float(n) : Vec3f{});
         }
-    return out;
 }
 
 double Film::noise_rms() const {

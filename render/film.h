@@ -52,6 +52,10 @@ public:
         count_[std::size_t(y) * std::size_t(sum_.width) + std::size_t(x)] += int(colors.size());
     }
     Image resolve() const;
+    /// The same into `out`, whose memory is reused when it has the film's size.
+    void resolve(Image& out) const;
+    int width() const { return sum_.width; }
+    int height() const { return sum_.height; }
     /// The standard error of each pixel's mean (sample variance / count,
     /// per channel), as the root mean square over pixels and channels: how
     /// far the image is likely to be from the converged one.

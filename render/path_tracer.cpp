@@ -7,6 +7,7 @@
 #include <limits>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -720,7 +721,9 @@ RenderStats render_path(const Scene& scene, const Accel& accel, const WhittedOpt
     PerWorker<Scratch> scratch;
     TileProgress progress(std::uint64_t(options.width) * std::uint64_t(options.height), options.progress,
                           options.progress_context);
-    Film film(options.width, options.height);
+    std::optional<Film> own_film;
+    const bool given = options.film && options.film->width() == options.width && options.film->height() == options.height;
+    Film& film = given ? *options.film : own_film.emplace(options.width, options.height);
     for_each_tile(grid, [&](int tile, int slot) {
         Scratch& s = scratch.at(slot);
         grid.pixels(tile, s.pixels);
@@ -742,7 +745,7 @@ RenderStats render_path(const Scene& scene, const Accel& accel, const WhittedOpt
         }
         progress.add(s.pixels.size());
     });
-    image = film.resolve();
+    film.resolve(image);
     RenderStats stats;
     stats.noise_rms = film.noise_rms();
     scratch.for_each([&](const Scratch& s) { stats += s.stats; });

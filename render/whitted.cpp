@@ -681,8 +681,12 @@ RenderStats render_whitted(const Scene& scene, const Accel& accel, const Whitted
     PerWorker<Scratch> scratch;
     TileProgress progress(std::uint64_t(options.width) * std::uint64_t(options.height), options.progress,
                           options.progress_context);
-    std::optional<Film> film;  // Whitted writes the image directly
-    if (spp > 1) film.emplace(options.width, options.height);
+    std::optional<Film> own_film;  // Whitted writes the image directly
+    Film* film = nullptr;
+    if (spp > 1) {
+        const bool given = options.film && options.film->width() == options.width && options.film->height() == options.height;
+        film = given ? options.film : &own_film.emplace(options.width, options.height);
+    }
     // One sample a pixel writes every pixel: an image of the right size
     // from the caller is kept (the command line makes it before the build,
     // so that its fresh pages are not faulted in on the render's clock).
@@ -727,7 +731,7 @@ RenderStats render_whitted(const Scene& scene, const Accel& accel, const Whitted
     });
     RenderStats stats;
     if (film) {
-        image = film->resolve();
+        film->resolve(image);
         stats.noise_rms = film->noise_rms();
     }
     scratch.for_each([&](const Scratch& s) { stats += s.stats; });

@@ -53,6 +53,11 @@ struct WhittedOptions {
     /// samples are keyed by the point, so shared corners agree.
     float adaptive_threshold = 0;
     int adaptive_depth = 3;
+    /// A fresh film of width x height made by the caller (sampled renders:
+    /// distribution with spp > 1, path), so that its pages are faulted in
+    /// before the render's clock starts, as the image's are; nullptr: the
+    /// render makes its own. The render adds its samples to it.
+    Film* film = nullptr;
     /// Called after each finished tile with the number of pixels done so far
     /// (from any thread; for progress reports). May be empty.
     void (*progress)(void* context, std::uint64_t pixels_done, std::uint64_t pixels_total) = nullptr;

@@ -246,6 +246,19 @@ TEST(DistributionRender, SameImageForAnyThreadCount) {
         render_whitted(s, *accel, o, two);
     }
     EXPECT_EQ(one.rgb, two.rgb);
+    // A film and an image the caller made beforehand (the command line's
+    // way) take the samples and give the same image; a film of another size
+    // is left alone.
+    Film film(o.width, o.height), other(5, 3);
+    Image three(o.width, o.height), four;
+    o.film = &film;
+    render_whitted(s, *accel, o, three);
+    EXPECT_EQ(three.rgb, one.rgb);
+    EXPECT_EQ(film.resolve().rgb, one.rgb);
+    o.film = &other;
+    render_whitted(s, *accel, o, four);
+    EXPECT_EQ(four.rgb, one.rgb);
+    EXPECT_EQ(other.resolve().rgb, std::vector<float>(5 * 3 * 3, 0.0f));
 }
 
 TEST(DistributionRender, SurfacesInLanesAreTheScalarPointsBitForBit) {

@@ -129,6 +129,14 @@ TEST(PathTracer, SameImageForAnyThreadCount) {
         render_path(s, *accel, o, PathOptions{}, two);
     }
     EXPECT_EQ(one.rgb, two.rgb);
+    // A film and an image the caller made beforehand take the samples and
+    // give the same image.
+    Film film(o.width, o.height);
+    Image three(o.width, o.height);
+    o.film = &film;
+    render_path(s, *accel, o, PathOptions{}, three);
+    EXPECT_EQ(three.rgb, one.rgb);
+    EXPECT_EQ(film.resolve().rgb, one.rgb);
 }
 
 TEST(PathTracer, VerticesInLanesAreTheScalarVerticesBitForBit) {
