@@ -216,7 +216,8 @@ Tris fan_of(std::size_t n) {
 }  // namespace
 
 TEST(Triangulate, ManySidedPolygonsGetCompactTrianglesNotSlivers) {
-    // A regular 64-gon, a 61-gon (odd passes) and a toothed disc like gears'.
+    // A regular 64-gon and a 61-gon (odd passes); gears' toothed discs are
+    // the 144-gons' case below.
     for (int n : {64, 61}) {
         SCOPED_TRACE(n);
         std::vector<Vec3f> v;
