@@ -275,7 +275,7 @@ void trace_group(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, int switc
     PacketNodeRay<K> nr[G];
     const bool together = count > 1 && one_octant<K>(p, count);
     if (together)
-        for (int q = 0; q < count; ++q) nr[q] = make_packet_node_ray<K>(p[q].ray, pk.kernels.slabs);
+        for (int q = 0; q < count; ++q) set_packet_node_ray<K>(p[q].ray, pk.kernels.slabs, nr[q]);
     GroupIntervals g;
     if (!together || !group_intervals<K>(nr, p, count, g) || origin_spread(g) > max_origin_spread) {
         for (int q = 0; q < count; ++q)
@@ -290,7 +290,7 @@ void trace_group(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, int switc
     float tfar_hi[G];  // per packet: the largest widened tfar of its valid lanes
     std::uint32_t live = 0;
     for (int q = 0; q < count; ++q) {
-        if constexpr (!ByPrim) lr[q] = make_packet_leaf_ray<K>(p[q].ray, TM);
+        if constexpr (!ByPrim) set_packet_leaf_ray<K>(p[q].ray, TM, lr[q]);
         tfar_hi[q] = lane_max<K>(select(s[q].valid, node_tfar(s[q].tfar), minus_inf));
         if (any(p[q].valid)) live |= 1u << q;
     }
