@@ -54,8 +54,7 @@ public:
     Image resolve() const;
     /// The same into `out`, whose memory is reused when it has the film's size.
     void resolve(Image& out) const;
-    int width() const { return sum_.width; }
-    int height() const { return sum_.height; }
+    bool has_size(int width, int height) const { return sum_.width == width && sum_.height == height; }
     /// The standard error of each pixel's mean (sample variance / count,
     /// per channel), as the root mean square over pixels and channels: how
     /// far the image is likely to be from the converged one.

@@ -722,8 +722,9 @@ RenderStats render_path(const Scene& scene, const Accel& accel, const WhittedOpt
     TileProgress progress(std::uint64_t(options.width) * std::uint64_t(options.height), options.progress,
                           options.progress_context);
     std::optional<Film> own_film;
-    const bool given = options.film && options.film->width() == options.width && options.film->height() == options.height;
-    Film& film = given ? *options.film : own_film.emplace(options.width, options.height);
+    Film& film = options.film && options.film->has_size(options.width, options.height)
+                     ? *options.film
+                     : own_film.emplace(options.width, options.height);
     for_each_tile(grid, [&](int tile, int slot) {
         Scratch& s = scratch.at(slot);
         grid.pixels(tile, s.pixels);

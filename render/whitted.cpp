@@ -684,8 +684,9 @@ RenderStats render_whitted(const Scene& scene, const Accel& accel, const Whitted
     std::optional<Film> own_film;  // Whitted writes the image directly
     Film* film = nullptr;
     if (spp > 1) {
-        const bool given = options.film && options.film->width() == options.width && options.film->height() == options.height;
-        film = given ? options.film : &own_film.emplace(options.width, options.height);
+        film = options.film && options.film->has_size(options.width, options.height)
+                   ? options.film
+                   : &own_film.emplace(options.width, options.height);
     }
     // One sample a pixel writes every pixel: an image of the right size
     // from the caller is kept (the command line makes it before the build,

@@ -165,11 +165,11 @@ RAYPACK_INLINE void packet_run(const Block* b, std::uint32_t count, SphereMethod
     constexpr int M = int(sizeof(b->prim) / sizeof(b->prim[0]));
     F minus_inf(-std::numeric_limits<float>::infinity());
     for (; count != 0; --count, ++b) {
-        [[maybe_unused]] std::uint32_t todo = 0;
-        if constexpr (Masked) todo = *slots++;
+        [[maybe_unused]] std::uint32_t may_hit = 0;  // Masked: the block's slots still to test
+        if constexpr (Masked) may_hit = *slots++;
         for (int j = 0; j < M && b->prim[j] != kNoPrim; ++j) {
             if constexpr (Masked)
-                if (!((todo >> j) & 1u)) continue;
+                if (!((may_hit >> j) & 1u)) continue;
             F t(0.0f), u(0.0f), v(0.0f);  // the kernels set only their hit lanes
             [[maybe_unused]] std::uint32_t ids[names_hits<Kind> ? K : 1];
             vmask<K> m;
