@@ -21,7 +21,13 @@ namespace raypack {
 /// which costs a test, never a hit.
 class PacketMailbox {
 public:
-    PacketMailbox() { std::fill(std::begin(prim_), std::end(prim_), kNoPrim); }
+    PacketMailbox() { clear(); }
+    /// Left unset until clear(): a group holds one per packet and clears only
+    /// those it uses.
+    struct Unset {};
+    explicit PacketMailbox(Unset) {}
+
+    void clear() { std::fill(std::begin(prim_), std::end(prim_), kNoPrim); }
 
     /// Lane bits of the lanes settled for `prim`; the caller adds to them.
     RAYPACK_INLINE std::uint32_t& settled(std::uint32_t prim) {

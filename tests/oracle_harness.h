@@ -37,6 +37,12 @@ inline std::string describe(const Rayf& r) {
     return os.str();
 }
 
+/// The same hit to the last bit: primitive, t, u and v.
+inline bool same_bits(const Hitf& a, const Hitf& b) {
+    const auto bits = [](float f) { return std::bit_cast<std::uint32_t>(f); };
+    return a.prim == b.prim && bits(a.t) == bits(b.t) && bits(a.u) == bits(b.u) && bits(a.v) == bits(b.v);
+}
+
 inline std::string describe(const Hitf& h) {
     if (!h.found()) return "miss";
     std::ostringstream os;

@@ -45,10 +45,6 @@ const char* const kStructures[] = {"grid", "octree", "kdtree"};
 
 std::uint32_t bits(float f) { return std::bit_cast<std::uint32_t>(f); }
 
-bool same_bits(const Hitf& a, const Hitf& b) {
-    return a.prim == b.prim && bits(a.t) == bits(b.t) && bits(a.u) == bits(b.u) && bits(a.v) == bits(b.v);
-}
-
 /// What a structure's answers lack against the oracle's.
 struct Disagreement {
     std::size_t lost = 0;     ///< the oracle hits, the structure misses (or is not occluded)

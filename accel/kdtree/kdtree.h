@@ -25,6 +25,9 @@ struct KdTreeConfig {
     /// splits", Havran's thesis 2000; Wald & Havran 2006); false uses their
     /// bounding boxes clipped to the voxel.
     bool perfect_splits = true;
+    /// Packets of rays from one point walk the tree in groups
+    /// (kdtree_trace_packets); false: every packet alone.
+    bool packet_groups = true;
 };
 
 /// 8 bytes, as pbrt's KdTreeNode. Inner node: `word` holds the split

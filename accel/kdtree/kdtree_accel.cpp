@@ -16,7 +16,7 @@
 namespace raypack {
 
 KdTreeAccel::KdTreeAccel(const Scene& scene, const AccelConfig& config, const KdTreeConfig& kd_config)
-    : scene_(&scene), kernels_(config.kernels) {
+    : scene_(&scene), kernels_(config.kernels), packet_groups_(kd_config.packet_groups) {
     const std::size_t n = scene.primitive_count();
     std::vector<Box3f> boxes(n);
     tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) { boxes[i] = primitive_bounds(scene, std::uint32_t(i)); });
@@ -182,7 +182,7 @@ bool KdTreeAccel::walk(Rayf& ray, Hitf& hit, KdRayCounters* counters) const {
 template <bool AnyHit>
 void KdTreeAccel::trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
     with_packet_width(width, "kdtree", [&]<int K>() {
-        kdtree_trace_packets<K, AnyHit>(tree_, *scene_, kernels_, rays, hits);
+        kdtree_trace_packets<K, AnyHit>(tree_, *scene_, kernels_, rays, hits, packet_groups_);
     });
 }
 

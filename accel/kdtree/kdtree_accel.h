@@ -44,6 +44,7 @@ private:
 
     const Scene* scene_;
     KernelChoice kernels_;
+    bool packet_groups_;
     KdTree tree_;
 };
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cmath>
 #include <cstring>
 #include <limits>
 
@@ -60,6 +61,74 @@ void restore_lanes(const vmask<K>& m, const HitPacket<K>& before, HitPacket<K>& 
     }
 }
 
+/// Whether the lanes `bits` share one sign per axis of their reciprocal
+/// directions.
+template <int K>
+RAYPACK_INLINE bool one_octant(const Vec3<vfloat<K>>& rdir, std::uint32_t bits) {
+    for (int a = 0; a < 3; ++a) {
+        const std::uint32_t positive = mask_bits(rdir[a] >= vfloat<K>(0.0f)) & bits;
+        if (positive != 0 && positive != bits) return false;
+    }
+    return true;
+}
+
+/// Whether a packet may start a group (trace_group): its rays leave one
+/// point and share one direction octant.
+template <int K>
+RAYPACK_INLINE bool may_lead_group(const LoadedPacket<K>& p) {
+    const std::uint32_t bits = mask_bits(p.valid);
+    if (!bits || !one_octant<K>(p.ray.rdir, bits)) return false;
+    const int first = std::countr_zero(bits);
+    for (int a = 0; a < 3; ++a)
+        if (mask_bits(p.ray.org[a] != vfloat<K>(lane(p.ray.org[a], first))) & bits) return false;
+    return true;
+}
+
+/// The primitives of leaf `node` against the lanes `active` (closest hits,
+/// or occlusion added to `occluded`), each primitive only on the lanes the
+/// packet's mailbox has not settled: the leaf step of both walks below.
+template <int K, bool AnyHit>
+RAYPACK_INLINE void test_leaf(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>>& isect,
+                              const KdNode& node, RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> active,
+                              vmask<K>& occluded, PacketMailbox& mailbox) {
+    using F = vfloat<K>;
+    using M = vmask<K>;
+    const F inf(std::numeric_limits<float>::infinity());
+    const bool double_ties = isect.kernels.precision == Precision::Double;
+    const std::uint32_t count = node.prim_count();
+    const std::uint32_t* prims = tree.leaf_prims(node);
+    for (std::uint32_t k = 0; k < count; ++k) {
+        // A test again only finds its own hit: ties go to the lowest primitive.
+        std::uint32_t& settled = mailbox.settled(prims[k]);
+        if (!(mask_bits(active) & ~settled)) continue;
+        settled |= mask_bits(active);
+        if constexpr (AnyHit) {
+            const M m = isect.intersect(active, ray, hit, prims[k]);
+            occluded = occluded | m;
+            active = active & !m;
+            if (none(active)) break;
+        } else if (double_ties) {  // see kd_tie_tfar()
+            const HitPacket<K> before = hit;
+            const F tfar = ray.tfar;
+            ray.tfar = select(active & (before.t < inf), kd_tie_tfar(tfar), tfar);
+            const M m = isect.intersect(active, ray, hit, prims[k]);
+            const M farther = m & (hit.t > before.t);
+            if (any(farther)) restore_lanes<K>(farther, before, hit);
+            ray.tfar = select(m & !farther, hit.t, tfar);
+            const M tie = m & !farther & (hit.t == before.t);
+            if (any(tie)) [[unlikely]]
+                keep_lowest_on_ties<K>(tie, before, hit, prims[k]);
+        } else {
+            const HitPacket<K> before = hit;
+            const M m = isect.intersect(active, ray, hit, prims[k]);
+            // Equal t: the lowest primitive number wins, as in the single-ray path.
+            const M tie = m & (hit.t == before.t);
+            if (ties_another_primitive<K>(mask_bits(tie), before, prims[k])) [[unlikely]]
+                keep_lowest_on_ties<K>(tie, before, hit, prims[k]);
+        }
+    }
+}
+
 // The single-ray traversal of kdtree_accel.cpp lane by lane: the same
 // widened planes, so every lane visits at least the leaves its single ray
 // would, and the same kernels, so the hits are bit for bit the same. A lane
@@ -95,7 +164,6 @@ void trace_packet(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>
     const std::uint32_t below_first_axes = std::uint32_t((mask_bits(positive[0]) & lanes) != 0) |
                                            std::uint32_t((mask_bits(positive[1]) & lanes) != 0) << 1 |
                                            std::uint32_t((mask_bits(positive[2]) & lanes) != 0) << 2;
-    const bool double_ties = isect.kernels.precision == Precision::Double;
     const KdNode* nodes = tree.nodes.data();
     // The far children still to visit, with their intervals: lanes stored
     // one by one (a struct of vectors made GCC copy them through scalar
@@ -179,39 +247,7 @@ void trace_packet(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>
                 if (visit_second && second_child && resume(second_lo, second_hi, second_child)) continue;
             }
         } else {
-            const std::uint32_t count = node.prim_count();
-            const std::uint32_t* prims = tree.leaf_prims(nodes[current]);
-            M active = tmin <= tmax;
-            for (std::uint32_t k = 0; k < count; ++k) {
-                // A test again only finds its own hit: ties go to the lowest primitive.
-                std::uint32_t& settled = mailbox.settled(prims[k]);
-                if (!(mask_bits(active) & ~settled)) continue;
-                settled |= mask_bits(active);
-                if constexpr (AnyHit) {
-                    const M m = isect.intersect(active, ray, hit, prims[k]);
-                    occluded = occluded | m;
-                    active = active & !m;
-                    if (none(active)) break;
-                } else if (double_ties) {  // see kd_tie_tfar()
-                    const HitPacket<K> before = hit;
-                    const F tfar = ray.tfar;
-                    ray.tfar = select(active & (before.t < inf), kd_tie_tfar(tfar), tfar);
-                    const M m = isect.intersect(active, ray, hit, prims[k]);
-                    const M farther = m & (hit.t > before.t);
-                    if (any(farther)) restore_lanes<K>(farther, before, hit);
-                    ray.tfar = select(m & !farther, hit.t, tfar);
-                    const M tie = m & !farther & (hit.t == before.t);
-                    if (any(tie)) [[unlikely]]
-                        keep_lowest_on_ties<K>(tie, before, hit, prims[k]);
-                } else {
-                    const HitPacket<K> before = hit;
-                    const M m = isect.intersect(active, ray, hit, prims[k]);
-                    // Equal t: the lowest primitive number wins, as in the single-ray path.
-                    const M tie = m & (hit.t == before.t);
-                    if (ties_another_primitive<K>(mask_bits(tie), before, prims[k])) [[unlikely]]
-                        keep_lowest_on_ties<K>(tie, before, hit, prims[k]);
-                }
-            }
+            test_leaf<K, AnyHit>(tree, isect, nodes[current], ray, hit, tmin <= tmax, occluded, mailbox);
             if constexpr (AnyHit) {
                 valid = valid & !occluded;
                 if (none(valid)) return;
@@ -226,53 +262,258 @@ void trace_packet(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>
     }
 }
 
+#if defined(__AVX2__)
+/// Up to G packets of rays from one point, in one direction octant, walk
+/// the tree together ("large packets": Reshetov, Soupikov & Hurley,
+/// "Multi-Level Ray Tracing Algorithm", SIGGRAPH 2005; Wald's thesis 2004).
+/// Each packet stands for its rays by intervals, per axis, of their
+/// reciprocal directions, from which a split's crossing is bounded for all
+/// of them at once; the walk is the single-ray walk on one interval [enter,
+/// leave] per packet, the packets in SIMD lanes, so an inner node costs a
+/// few vector operations for all the group's rays instead of a step per
+/// packet. Rounding is monotone, so the corner products (split - o) * r
+/// bound every lane's own t_split and the largest |r| its slack (as
+/// trace_packet computes them, robust slabs): a packet enters every node
+/// one of its lanes would. At a leaf each packet that reaches it clips its
+/// lanes to the leaf's cell, widened by twice the tree's margin so that
+/// every lane whose own walk reaches the leaf is among them, and tests the
+/// primitives as trace_packet does, so every lane tests at least the
+/// primitives its single ray would and keeps the same closest hit (ties go
+/// to the lowest primitive in both). Origins must coincide: with origins
+/// spread over a patch (shadow rays), rays nearly parallel to a split bound
+/// nothing. Robust slabs and float precision only; false (nothing traced)
+/// if the packets do not share one origin and octant or a lane's origin or
+/// reciprocal is not finite.
+template <int K, int G, bool AnyHit>
+bool trace_group(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>>& isect, LoadedPacket<K>* p,
+                 int count) {
+    using F = vfloat<K>;
+    using M = vmask<K>;
+    using PF = vfloat<8>;  // one lane per packet, G / 8 vectors of them
+    constexpr int H = G / 8;
+    static_assert(G % 8 == 0 && G <= 32);
+    const float inf = std::numeric_limits<float>::infinity();
+    const F finf(inf), zero(0.0f);
+    M lanes[G];  // per packet: the lanes still traced
+    alignas(32) float o_lo[3][G], o_hi[3][G], r_lo[3][G], r_hi[3][G], r_abs[3][G], t_in[G], t_out[G], t_far[G];
+    std::uint32_t up = 0, down = 0, live = 0;
+    F non_finite = zero;
+    for (int q = 0; q < count; ++q) {
+        const RayPacket<K>& ray = p[q].ray;
+        F t0, t1;
+        const M in = kd_ray_interval<F>(p[q].valid, ray.org, ray.rdir, ray.tnear, ray.tfar, tree.bounds, tree.margin,
+                                        t0, t1);
+        lanes[q] = in;
+        const std::uint32_t bits = mask_bits(in);
+        if (bits == 0) continue;
+        live |= 1u << q;
+        for (int a = 0; a < 3; ++a) {
+            const std::uint32_t pos = mask_bits(ray.rdir[a] >= zero) & bits;
+            up |= pos != 0 ? 1u << a : 0u;
+            down |= pos != bits ? 1u << a : 0u;
+            const F o = ray.org[a], r = ray.rdir[a];
+            non_finite = non_finite + select(in, (o - o) + (r - r), zero);
+            o_lo[a][q] = lane_min<K>(select(in, o, finf));
+            o_hi[a][q] = lane_max<K>(select(in, o, -finf));
+            r_lo[a][q] = lane_min<K>(select(in, r, finf));
+            r_hi[a][q] = lane_max<K>(select(in, r, -finf));
+            r_abs[a][q] = std::max(std::fabs(r_lo[a][q]), std::fabs(r_hi[a][q]));
+            // Bounds by intervals are tight only for rays from one point:
+            // packets whose origins spread walk alone (shadow rays from a
+            // patch, nearly parallel to a split, would bound nothing).
+            if (o_lo[a][q] != o_hi[a][q]) return false;
+        }
+        t_in[q] = lane_min<K>(select(in, t0, finf));
+        t_out[q] = lane_max<K>(select(in, t1, -finf));
+        t_far[q] = lane_max<K>(select(in, ray.tfar, -finf));
+    }
+    if ((up & down) != 0 || any(non_finite != non_finite)) return false;
+    if (live == 0) return true;
+    for (int q = 0; q < G; ++q)  // packets without a lane in the box, or past the group: empty intervals
+        if (!((live >> q) & 1u)) {
+            for (int a = 0; a < 3; ++a) o_lo[a][q] = o_hi[a][q] = r_lo[a][q] = r_hi[a][q] = r_abs[a][q] = 0.0f;
+            t_in[q] = inf, t_out[q] = -inf, t_far[q] = -inf;
+        }
+    PF tfar[H], enter[H], leave[H];
+    for (int h = 0; h < H; ++h) {
+        tfar[h] = PF::load_aligned(t_far + 8 * h);
+        enter[h] = PF::load_aligned(t_in + 8 * h);
+        leave[h] = PF::load_aligned(t_out + 8 * h);
+    }
+    struct UnsetMailbox : PacketMailbox {
+        UnsetMailbox() : PacketMailbox(Unset{}) {}
+    };
+    UnsetMailbox mailbox[G];
+    for (int q = 0; q < count; ++q) mailbox[q].clear();
+    // The far children still to visit: the packets' intervals in them, and
+    // the cell (for the leaves' clips). No constructors: left unset.
+    struct Pending {
+        std::uint32_t node, packets;
+        float lo[3], hi[3];
+    };
+    alignas(32) float stack_enter[kKdMaxDepth + 1][G], stack_leave[kKdMaxDepth + 1][G];
+    Pending stack[kKdMaxDepth + 1];
+    int sp = 0;
+    const KdNode* nodes = tree.nodes.data();
+    const PF margin(tree.margin);
+    std::uint32_t current = 0, packets = live;
+    Box3f cell = tree.bounds;
+    for (;;) {
+        const KdNode& node = nodes[current];
+        if (!node.is_leaf()) {
+            const int a = node.axis();
+            float split_pos;
+            std::memcpy(&split_pos, &node.word, sizeof split_pos);
+            const PF split(split_pos);
+            PF near_hi[H], far_lo[H];
+            std::uint32_t near_packets = 0, far_packets = 0;
+            for (int h = 0; h < H; ++h) {
+                const PF d0 = split - PF::load_aligned(o_hi[a] + 8 * h), d1 = split - PF::load_aligned(o_lo[a] + 8 * h);
+                const PF rl = PF::load_aligned(r_lo[a] + 8 * h), rh = PF::load_aligned(r_hi[a] + 8 * h);
+                const PF c0 = d0 * rl, c1 = d0 * rh, c2 = d1 * rl, c3 = d1 * rh;
+                const PF slack = margin * PF::load_aligned(r_abs[a] + 8 * h);
+                // Whichever way the rays go, the near side ends at t_split +
+                // slack and the far side starts at t_split - slack.
+                const PF near_end = vmax(vmax(c0, c1), vmax(c2, c3)) + slack;
+                const PF far_start = vmin(vmin(c0, c1), vmin(c2, c3)) - slack;
+                near_hi[h] = vmin(leave[h], near_end);
+                far_lo[h] = vmax(enter[h], far_start);
+                near_packets |= mask_bits((enter[h] <= near_hi[h]) & (enter[h] <= tfar[h])) << (8 * h);
+                far_packets |= mask_bits((far_lo[h] <= leave[h]) & (far_lo[h] <= tfar[h])) << (8 * h);
+            }
+            near_packets &= packets;
+            far_packets &= packets;
+            const bool below_first = (up >> a) & 1u;
+            const std::uint32_t below = node.below_child(current), above = node.above_child();
+            const std::uint32_t near = below_first ? below : above, far = below_first ? above : below;
+            if (near && near_packets) {
+                if (far && far_packets) {
+                    Pending& e = stack[sp];
+                    e.node = far, e.packets = far_packets;
+                    for (int b = 0; b < 3; ++b) e.lo[b] = cell.lo[b], e.hi[b] = cell.hi[b];
+                    (below_first ? e.lo : e.hi)[a] = split_pos;
+                    for (int h = 0; h < H; ++h) {
+                        far_lo[h].store_aligned(stack_enter[sp] + 8 * h);
+                        leave[h].store_aligned(stack_leave[sp] + 8 * h);
+                    }
+                    ++sp;
+                }
+                (below_first ? cell.hi : cell.lo)[a] = split_pos;
+                for (int h = 0; h < H; ++h) leave[h] = near_hi[h];
+                current = near, packets = near_packets;
+                continue;
+            }
+            if (far && far_packets) {
+                (below_first ? cell.lo : cell.hi)[a] = split_pos;
+                for (int h = 0; h < H; ++h) enter[h] = far_lo[h];
+                current = far, packets = far_packets;
+                continue;
+            }
+        } else if (node.prim_count() != 0) {
+            alignas(32) float t_far_now[G];
+            for (int h = 0; h < H; ++h) tfar[h].store_aligned(t_far_now + 8 * h);
+            for (std::uint32_t b = packets; b != 0; b &= b - 1) {
+                const int q = std::countr_zero(b);
+                RayPacket<K>& ray = p[q].ray;
+                F t0, t1;
+                const M in = kd_ray_interval<F>(lanes[q], ray.org, ray.rdir, ray.tnear, ray.tfar, cell,
+                                                2.0f * tree.margin, t0, t1);
+                if (none(in)) continue;
+                test_leaf<K, AnyHit>(tree, isect, node, ray, p[q].hit, in, p[q].occluded, mailbox[q]);
+                if constexpr (AnyHit) {
+                    lanes[q] = lanes[q] & !p[q].occluded;
+                    if (none(lanes[q])) live &= ~(1u << q), t_far_now[q] = -inf;
+                } else {
+                    t_far_now[q] = lane_max<K>(select(lanes[q], ray.tfar, -finf));
+                }
+            }
+            if (live == 0) return true;
+            for (int h = 0; h < H; ++h) tfar[h] = PF::load_aligned(t_far_now + 8 * h);
+        }
+        // Pop the next node some packet may reach before its closest hits.
+        for (;;) {
+            if (sp == 0) return true;
+            --sp;
+            std::uint32_t reach = 0;
+            for (int h = 0; h < H; ++h)
+                reach |= mask_bits(PF::load_aligned(stack_enter[sp] + 8 * h) <= tfar[h]) << (8 * h);
+            packets = stack[sp].packets & live & reach;
+            if (packets) {
+                current = stack[sp].node;
+                for (int h = 0; h < H; ++h) {
+                    enter[h] = PF::load_aligned(stack_enter[sp] + 8 * h);
+                    leave[h] = PF::load_aligned(stack_leave[sp] + 8 * h);
+                }
+                cell.lo = {stack[sp].lo[0], stack[sp].lo[1], stack[sp].lo[2]};
+                cell.hi = {stack[sp].hi[0], stack[sp].hi[1], stack[sp].hi[2]};
+                break;
+            }
+        }
+    }
+}
+
+#endif  // __AVX2__
+
 }  // namespace
 
 template <int K, bool AnyHit>
 void kdtree_trace_packets(const KdTree& tree, const Scene& scene, KernelChoice kernels, std::span<const Rayf> rays,
-                          std::span<Hitf> hits) {
+                          std::span<Hitf> hits, bool groups) {
     using F = vfloat<K>;
     const PacketPrimitiveIntersector<F> isect{&scene, kernels};
     // The slab form is chosen once for all packets, rdir once per packet.
     with_slab_form(kernels.slabs, [&]<SlabMethod Slabs>(SlabTag<Slabs>) {
-        trace_in_packets<K, AnyHit>(rays, hits, kernels.rcp, [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid,
-                                                    vmask<K>& occluded) {
+        const auto trace_one = [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid, vmask<K>& occluded) {
             if (tree.empty()) return;
             vfloat<K> tmin, tmax;
             const vmask<K> in_box = kd_ray_interval<vfloat<K>, Slabs>(valid, ray.org, ray.rdir, ray.tnear, ray.tfar,
                                                                       tree.bounds, tree.margin, tmin, tmax);
             const std::uint32_t lanes = mask_bits(in_box);
             if (!lanes) return;
-            bool same_signs = true;
-            for (const auto& d : {ray.rdir.x, ray.rdir.y, ray.rdir.z}) {
-                const std::uint32_t positive = mask_bits(d >= vfloat<K>(0.0f)) & lanes;
-                same_signs = same_signs && (positive == 0 || positive == lanes);
-            }
-            if (same_signs)
+            if (one_octant<K>(ray.rdir, lanes))
                 trace_packet<K, AnyHit, Slabs, true>(tree, isect, ray, hit, valid, occluded, in_box, tmin, tmax);
             else
                 trace_packet<K, AnyHit, Slabs, false>(tree, isect, ray, hit, valid, occluded, in_box, tmin, tmax);
-        });
+        };
+        // Rays from one point (pinhole camera rays) walk in groups; the
+        // walk's bounds need robust slabs and float tests (trace_group).
+#if defined(__AVX2__)
+        if constexpr (Slabs == SlabMethod::Robust) {
+            if (groups && !tree.empty() && kernels.precision == Precision::Float) {
+                constexpr int G = kKdGroupPackets;
+                trace_in_groups<K, G, AnyHit>(
+                    rays, hits, kernels.rcp, [](const LoadedPacket<K>& p) { return may_lead_group<K>(p); }, trace_one,
+                    [&](LoadedPacket<K>* p, int count) {
+                        if (count > 1 && trace_group<K, G, AnyHit>(tree, isect, p, count)) return;
+                        for (int q = 0; q < count; ++q) trace_one(p[q].ray, p[q].hit, p[q].valid, p[q].occluded);
+                    });
+                return;
+            }
+        }
+#else
+        (void)groups;
+#endif
+        trace_in_packets<K, AnyHit>(rays, hits, kernels.rcp, trace_one);
     });
 }
 
 #if defined(__SSE4_2__)
-template void kdtree_trace_packets<4, false>(const KdTree&, const Scene&, KernelChoice, std::span<const Rayf>,
-                                               std::span<Hitf>);
-template void kdtree_trace_packets<4, true>(const KdTree&, const Scene&, KernelChoice, std::span<const Rayf>,
-                                               std::span<Hitf>);
+template void kdtree_trace_packets<4, false>(const KdTree&, const Scene&, KernelChoice,
+                                                std::span<const Rayf>, std::span<Hitf>, bool);
+template void kdtree_trace_packets<4, true>(const KdTree&, const Scene&, KernelChoice,
+                                                std::span<const Rayf>, std::span<Hitf>, bool);
 #endif
 #if defined(__AVX2__)
-template void kdtree_trace_packets<8, false>(const KdTree&, const Scene&, KernelChoice, std::span<const Rayf>,
-                                               std::span<Hitf>);
-template void kdtree_trace_packets<8, true>(const KdTree&, const Scene&, KernelChoice, std::span<const Rayf>,
-                                               std::span<Hitf>);
+template void kdtree_trace_packets<8, false>(const KdTree&, const Scene&, KernelChoice,
+                                                std::span<const Rayf>, std::span<Hitf>, bool);
+template void kdtree_trace_packets<8, true>(const KdTree&, const Scene&, KernelChoice,
+                                                std::span<const Rayf>, std::span<Hitf>, bool);
 #endif
 #if defined(__AVX512BW__)
-template void kdtree_trace_packets<16, false>(const KdTree&, const Scene&, KernelChoice, std::span<const Rayf>,
-                                               std::span<Hitf>);
-template void kdtree_trace_packets<16, true>(const KdTree&, const Scene&, KernelChoice, std::span<const Rayf>,
-                                               std::span<Hitf>);
+template void kdtree_trace_packets<16, false>(const KdTree&, const Scene&, KernelChoice,
+                                                std::span<const Rayf>, std::span<Hitf>, bool);
+template void kdtree_trace_packets<16, true>(const KdTree&, const Scene&, KernelChoice,
+                                                std::span<const Rayf>, std::span<Hitf>, bool);
 #endif
 
 }  // namespace raypack
