@@ -265,6 +265,26 @@ RAYPACK_INLINE std::uint32_t mask_bits(const xsimd::batch_bool<float, A>& m) {
     else static_assert(sizeof(A) == 0, "mask_bits: unsupported arch");
 }
 
+/// The lanes `bits` as a mask, lane i from bit i (mask_bits' inverse).
+template <int K>
+RAYPACK_INLINE vmask<K> mask_from_bits(std::uint32_t bits) {
+#if defined(__AVX512F__)
+    if constexpr (K == 16) return vmask<K>(__mmask16(bits));
+#endif
+#if defined(__AVX2__)
+    if constexpr (K == 8) {
+        const __m256i lane_bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+        const __m256i b = _mm256_and_si256(_mm256_set1_epi32(int(bits)), lane_bit);
+        return vmask<K>(_mm256_castsi256_ps(_mm256_cmpeq_epi32(b, lane_bit)));
+    }
+#endif
+    if constexpr (K == 4) {
+        const __m128i lane_bit = _mm_setr_epi32(1, 2, 4, 8);
+        const __m128i b = _mm_and_si128(_mm_set1_epi32(int(bits)), lane_bit);
+        return vmask<K>(_mm_castsi128_ps(_mm_cmpeq_epi32(b, lane_bit)));
+    }
+}
+
 /// Loads and stores of K consecutive floats.
 template <class F>
 RAYPACK_INLINE F load_lanes(const float* p) {

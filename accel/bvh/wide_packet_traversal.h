@@ -250,14 +250,6 @@ struct PacketKernels {
     PacketPrimitiveIntersector<vfloat<K>> packet;
 };
 
-/// The lanes `bits` as a mask.
-template <int K>
-RAYPACK_INLINE vmask<K> mask_from_bits(std::uint32_t bits) {
-    alignas(64) float f[K];
-    for (int i = 0; i < K; ++i) f[i] = (bits >> i) & 1u ? 1.0f : 0.0f;
-    return vfloat<K>::load_aligned(f) > vfloat<K>(0.0f);
-}
-
 /// The lanes `bits` finish the subtree under `root` one ray at a time
 /// (Benthin et al. 2012), each from its own closest hit so far.
 template <int N, int M, int K, TriangleMethod TM, bool AnyHit, bool ByPrim, class Kinds>

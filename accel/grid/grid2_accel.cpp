@@ -188,7 +188,7 @@ void Grid2Accel::trace_packet(const PacketPrimitiveIntersector<vfloat<K>>& isect
         }
     }
     if constexpr (AnyHit) {
-        occluded = occluded | grid_lanes::mask_from_bits<K>(blocked);
+        occluded = occluded | mask_from_bits<K>(blocked);
     } else {
         hit.t = load_lanes<F>(t), hit.u = load_lanes<F>(u), hit.v = load_lanes<F>(v);
         ray.tfar = load_lanes<F>(tfar);
