@@ -293,11 +293,11 @@ inline constexpr std::uint32_t kMaxCulledPrims = 32;
 /// primitives as trace_packet does (but those whose widened boxes its
 /// bounds miss, where kMinPacketsToCull packets reach the leaf), so every
 /// lane tests at least the primitives its single ray would find and keeps
-/// the same closest hit (ties go to the lowest primitive in both). Origins must coincide: with origins
-/// spread over a patch (shadow rays), rays nearly parallel to a split bound
-/// nothing. Robust slabs and float precision only; false (nothing traced)
-/// if the packets do not share one origin and octant or a lane's origin or
-/// reciprocal is not finite.
+/// the same closest hit (ties go to the lowest primitive in both).
+/// Origins must coincide: with origins spread over a patch (shadow rays),
+/// rays nearly parallel to a split bound nothing. Robust slabs and float
+/// precision only; false (nothing traced) if the packets do not share one
+/// origin and octant or a lane's origin or reciprocal is not finite.
 template <int K, int G, bool AnyHit>
 bool trace_group(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>>& isect, LoadedPacket<K>* p,
                  int count) {
@@ -452,7 +452,7 @@ bool trace_group(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>>
                 const std::uint32_t* prims = tree.leaf_prims(node);
                 const float pad = culling_pad(cell);
                 for (std::uint32_t k = 0; k < n_prims; ++k) {
-                    Box3f b = primitive_bounds(*isect.scene, prims[k]);
+                    const Box3f b = primitive_bounds(*isect.scene, prims[k]);
                     std::uint32_t bits = 0;
                     for (int h = 0; h < H; ++h) {
                         PF entry(-inf), exit(inf);
