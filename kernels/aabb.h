@@ -4,6 +4,7 @@
 // against K boxes stored as SoA.
 #include <immintrin.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <utility>
@@ -161,6 +162,23 @@ template <class T>
 RAYPACK_INLINE bool intersect_aabb(const Vec3<T>& org, const Vec3<T>& inv_dir, const Box3<T>& box, T tnear, T tfar, T& entry) {
     const SlabRay<T> ray{org, inv_dir, {}, tnear, tfar};  // robust: org_rdir unused
     return intersect_box<SlabMethod::Robust, T>(true, ray, box.lo, box.hi, entry);
+}
+
+/// How far primitive boxes are widened before a group of rays, with
+/// origins in [o_lo, o_hi], culls them by their boxes instead of testing
+/// them: 2^-13 of the largest of the region's extent and its distance from
+/// the origins. The boxes only stand in for the primitive tests, which are
+/// not exact: Moeller's test may report a hit a little outside the triangle
+/// (at grazing angles by about eps x distance / sin(angle)); so widened, a
+/// box drops only hits the single ray would also have to find more than
+/// 2^-13 x distance off the triangle, i.e. rays within about 0.03 degrees
+/// of its plane. Used by the BVH's and the k-d tree's groups.
+inline float culling_box_pad(const Box3f& region, const float (&o_lo)[3], const float (&o_hi)[3]) {
+    float reach = 0.0f;
+    for (int a = 0; a < 3; ++a)
+        reach = std::max({reach, region.hi[a] - region.lo[a], std::fabs(region.hi[a] - o_lo[a]),
+                          std::fabs(o_hi[a] - region.lo[a])});
+    return reach * 0x1p-13f;
 }
 
 }  // namespace raypack

@@ -194,22 +194,6 @@ RAYPACK_INLINE bool slot_boxes(const Block& b, vfloat<M> (&lo)[3], vfloat<M> (&h
 /// packets do (a leaf with more is tested whole).
 constexpr int kMaxCulledBlocks = 8;
 
-/// How far the primitives' boxes are widened before the group's interval
-/// test: 2^-13 of the largest of the leaf's extent and its distance from
-/// the group's origins. The boxes only stand in for the primitive tests,
-/// which are not exact: Moeller's test may report a hit a little outside
-/// the triangle (at grazing angles by about eps x distance / sin(angle));
-/// so widened, a box drops only hits the single ray would also have to
-/// find more than 2^-13 x distance off the triangle, i.e. rays within
-/// about 0.03 degrees of its plane.
-RAYPACK_INLINE float slot_box_pad(const Box3f& leaf, const GroupIntervals& g) {
-    float reach = 0.0f;
-    for (int a = 0; a < 3; ++a)
-        reach = std::max({reach, leaf.hi[a] - leaf.lo[a], std::fabs(leaf.hi[a] - g.o_lo[a]),
-                          std::fabs(g.o_hi[a] - leaf.lo[a])});
-    return reach * 0x1p-13f;
-}
-
 /// The primitives of leaf `code` that some ray of the group may meet
 /// before `tfar_hi`: a slot mask per block in `slots`, in the order the
 /// leaf's runs are visited (packet_leaf). Returns how many primitives are
@@ -315,7 +299,7 @@ void trace_group(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, int switc
             std::uint32_t slots[kMaxCulledBlocks];
             int kept = -1;
             if constexpr (!ByPrim)
-                kept = group_leaf_slots<TM, Kinds>(bvh, cur, g, tfar_group, slot_box_pad(box_node.box(slot), g), slots);
+                kept = group_leaf_slots<TM, Kinds>(bvh, cur, g, tfar_group, culling_box_pad(box_node.box(slot), g.o_lo, g.o_hi), slots);
             for (std::uint32_t bits = kept == 0 ? 0u : cur_packets; bits != 0; bits &= bits - 1) {
                 const int q = std::countr_zero(bits);
                 F e;

@@ -348,7 +348,7 @@ bool trace_group(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>>
             for (int a = 0; a < 3; ++a) o_lo[a][q] = o_hi[a][q] = r_lo[a][q] = r_hi[a][q] = r_abs[a][q] = 0.0f;
             t_in[q] = inf, t_out[q] = -inf, t_far[q] = -inf;
         }
-    float g_lo[3], g_hi[3];  // the packets' origins, all of them
+    float g_lo[3], g_hi[3];  // the packets' origins, all of them (culling_box_pad)
     for (int a = 0; a < 3; ++a) {
         g_lo[a] = inf, g_hi[a] = -inf;
         for (std::uint32_t b = live; b != 0; b &= b - 1) {
@@ -356,16 +356,6 @@ bool trace_group(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>>
             g_lo[a] = std::min(g_lo[a], o_lo[a][q]), g_hi[a] = std::max(g_hi[a], o_hi[a][q]);
         }
     }
-    // Primitive boxes are widened by 2^-13 of the largest of the cell's
-    // extent and its distance from the origins before the test, as the
-    // BVH's group culling does (wide_group_traversal.h, slot_box_pad): a
-    // kernel may report a hit a little off its primitive.
-    const auto culling_pad = [&](const Box3f& c) {
-        float reach = 0.0f;
-        for (int a = 0; a < 3; ++a)
-            reach = std::max({reach, c.hi[a] - c.lo[a], std::fabs(c.hi[a] - g_lo[a]), std::fabs(g_hi[a] - c.lo[a])});
-        return reach * 0x1p-13f;
-    };
     PF tfar[H], enter[H], leave[H];
     for (int h = 0; h < H; ++h) {
         tfar[h] = PF::load_aligned(t_far + 8 * h);
@@ -450,7 +440,7 @@ bool trace_group(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>>
             const bool culled = n_prims <= kMaxCulledPrims && std::popcount(packets) >= kMinPacketsToCull;
             if (culled) {
                 const std::uint32_t* prims = tree.leaf_prims(node);
-                const float pad = culling_pad(cell);
+                const float pad = culling_box_pad(cell, g_lo, g_hi);
                 for (std::uint32_t k = 0; k < n_prims; ++k) {
                     const Box3f b = primitive_bounds(*isect.scene, prims[k]);
                     std::uint32_t bits = 0;
