@@ -18,8 +18,10 @@
 #include "accel/counting_accel.h"
 #include "measure/cost_map.h"
 #include "render/path_tracer.h"
+#include "render/ray_log.h"
 #include "render/whitted.h"
 #include "scene/load.h"
+#include "scene/ray_file.h"
 #include "scene/memory_budget.h"
 
 namespace raypack::app {
@@ -103,7 +105,7 @@ int run_render(const Args& args) {
                              {"--quiet", "-q", 0}, {"--integrator", "", 1}, {"--spp", "", 1}, {"--sampler", "", 1},
                              {"--seed", "", 1}, {"--light-samples", "", 1}, {"--filter", "", 1},
                              {"--rr-depth", "", 1}, {"--exposure", "", 1}, {"--adaptive", "", 1},
-                             {"--adaptive-depth", "", 1}, {"--counts", "", 0}});
+                             {"--adaptive-depth", "", 1}, {"--counts", "", 0}, {"--save-rays", "", 1}});
     for (OptionSpec& k : scene_option_specs()) spec.push_back(std::move(k));
     const ParsedArgs p(args, spec, 1);
     if (p.help() || p.positional().empty()) {
@@ -134,6 +136,10 @@ int run_render(const Args& args) {
             "  --counts      trace every ray through the structure's counting walk (slower, the same\n"
             "                image) and report Havran's measures per ray over all the render's rays:\n"
             "                N_IT tests, N_TS traversal steps, N_ETS leaves or cells, N_EETS empty ones\n"
+            "  --save-rays PREFIX  also write every ray the render traced, by kind, in the order it\n"
+            "                traced them: PREFIX-eye.rays, PREFIX-bounce.rays (reflected, refracted, diffuse),\n"
+            "                PREFIX-shadow.rays (docs/rays.md; kinds with no rays get no file), so that\n"
+            "                `raypack trace` can time the render's own rays\n"
             "  --json        print one JSON line (times, ray counts, Mrays/s) instead of the text report\n"
             "  --quiet, -q   print nothing on success\n"
             "  A progress line is shown on a terminal for renders that take more than a second.\n%s",
@@ -234,6 +240,15 @@ int run_render(const Args& args) {
     // Secondary rays: the widest packets (measured on balls, gears and
     // tetra, 1 thread: 16 beat 1 by 0-12%, 4 lost 10-30%), or --packet.
     options.secondary_packet = p.has("--packet") ? options.packet : supported_packet(*accel, 16);
+    // --save-rays: every ray kept in memory until the render ends, at most
+    // half of what the machine has free (a ray and its time: 36 bytes).
+    std::optional<RayLog> ray_log;
+    const std::string rays_prefix = p.text("--save-rays");
+    if (p.has("--save-rays")) {
+        if (rays_prefix.empty()) throw UsageError("--save-rays: expected a file prefix");
+        const std::uint64_t available = available_memory();
+        options.ray_log = &ray_log.emplace(available > 0 ? available / 2 / (sizeof(Rayf) + sizeof(float)) : 1ull << 27);
+    }
     const bool json = p.has("--json"), quiet = p.has("--quiet");
     ProgressLine progress(!json && !quiet && ::isatty(STDOUT_FILENO));
     options.progress = &ProgressLine::report;
@@ -246,6 +261,14 @@ int run_render(const Args& args) {
     t0 = std::chrono::steady_clock::now();
     write_image(output, image);
     const double write_ms = ms_since(t0);
+    std::vector<std::string> saved_rays;
+    if (ray_log)
+        for (const RayLog::Kind kind : {RayLog::Eye, RayLog::Bounce, RayLog::Shadow}) {
+            if (ray_log->rays(kind).empty()) continue;
+            saved_rays.push_back(rays_prefix + "-" + RayLog::name(kind) + ".rays");
+            write_rays(saved_rays.back(), kind == RayLog::Shadow ? RayKind::AnyHit : RayKind::ClosestHit,
+                       ray_log->rays(kind), ray_log->times(kind));
+        }
     const double mrays = stats.render_ms > 0 ? double(stats.total_rays()) / (stats.render_ms * 1e3) : 0.0;
 
     // --counts: Havran's measures per ray over every ray of the render.
@@ -305,6 +328,7 @@ int run_render(const Args& args) {
             j["samples_per_pixel"] = stats.samples_per_pixel;
         }
         j["output"] = std::filesystem::absolute(output).string();
+        if (ray_log) j["saved_rays"] = saved_rays;
         std::printf("%s\n", j.dump().c_str());
         return 0;
     }
@@ -346,6 +370,7 @@ int run_render(const Args& args) {
         std::printf("  counts     per ray over %llu rays: N_IT %.2f, N_TS %.2f, N_ETS %.2f, N_EETS %.2f\n",
                     (unsigned long long)counter->rays(), per_ray->it, per_ray->ts, per_ray->ets, per_ray->eets);
     std::printf("  image      %s (written in %.1f ms)\n", std::filesystem::absolute(output).string().c_str(), write_ms);
+    for (const std::string& f : saved_rays) std::printf("  rays file  %s\n", std::filesystem::absolute(f).string().c_str());
     return 0;
 }
 

@@ -161,7 +161,9 @@ public:
         for (int depth = 1; !s.paths.rays.empty(); ++depth) {
             Paths& p = s.paths;
             const int width = depth == 1 ? options_.packet : options_.secondary_packet;
-            if (timed_) accel_.intersect_at(width, p.rays, times_of(p.sample, s), p.hits);
+            const auto times = timed_ ? times_of(p.sample, s) : std::span<const float>{};
+            if (options_.ray_log) options_.ray_log->add(depth == 1 ? RayLog::Eye : RayLog::Bounce, p.rays, times);
+            if (timed_) accel_.intersect_at(width, p.rays, times, p.hits);
             else accel_.intersect_packets(width, p.rays, p.hits);
             if (depth == 1)
                 for (const Hitf& h : p.hits) s.stats.eye_hits += h.found();
@@ -702,7 +704,9 @@ private:
         Shadows& b = s.shadows;
         if (b.rays.empty()) return;
         b.occluded.resize(b.rays.size());
-        if (timed_) accel_.occluded_at(options_.secondary_packet, b.rays, times_of(b.sample, s), b.occluded);
+        const auto times = timed_ ? times_of(b.sample, s) : std::span<const float>{};
+        if (options_.ray_log) options_.ray_log->add(RayLog::Shadow, b.rays, times);
+        if (timed_) accel_.occluded_at(options_.secondary_packet, b.rays, times, b.occluded);
         else accel_.occluded_packets(options_.secondary_packet, b.rays, b.occluded);
         for (std::size_t k = 0; k < b.rays.size(); ++k)
             if (!b.occluded[k]) s.radiance[b.sample[k]] += b.contribution[k];

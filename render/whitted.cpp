@@ -191,10 +191,10 @@ public:
     /// after s.tree.reset(eye)); their colours end in s.tree.color[0 .. eye).
     void trace(std::size_t eye, Scratch& s) const {
         RayTree& tree = s.tree;
-        intersect(options_.packet, 0, eye, tree);
+        intersect(RayLog::Eye, 0, eye, tree);
         std::size_t begin = 0, end = eye;
         for (int depth = 1; begin < end; ++depth) {
-            if (depth > 1) intersect(options_.secondary_packet, begin, end, tree);
+            if (depth > 1) intersect(RayLog::Bounce, begin, end, tree);
             shade_level(begin, end, depth, s);
             begin = end;
             end = tree.count;
@@ -227,11 +227,15 @@ private:
     bool timed_;             ///< rays carry times (RayTree::time)
     bool lanes_;             ///< hits become shading points in SIMD lanes (add_points_in_lanes)
 
-    /// Closest hits of the tree's rays [begin, end), at their times if timed.
-    void intersect(int width, std::size_t begin, std::size_t end, RayTree& tree) const {
+    /// Closest hits of the tree's rays [begin, end) (eye rays or bounces),
+    /// at their times if timed.
+    void intersect(RayLog::Kind kind, std::size_t begin, std::size_t end, RayTree& tree) const {
+        const int width = kind == RayLog::Eye ? options_.packet : options_.secondary_packet;
         const auto rays = std::span(tree.rays).subspan(begin, end - begin);
         const auto hits = std::span(tree.hits).subspan(begin, end - begin);
-        if (timed_) accel_.intersect_at(width, rays, std::span(tree.time).subspan(begin, end - begin), hits);
+        const auto times = std::span(tree.time).subspan(begin, timed_ ? end - begin : 0);
+        if (options_.ray_log) options_.ray_log->add(kind, rays, times);
+        if (timed_) accel_.intersect_at(width, rays, times, hits);
         else accel_.intersect_packets(width, rays, hits);
     }
 
@@ -534,14 +538,13 @@ private:
         for (const ShadowQueue& q : b.per_light) b.all.insert(b.all.end(), q.rays.begin(), q.rays.end());
         if (b.all.empty()) return;
         b.occluded.resize(b.all.size());
-        if (timed_) {
-            b.times.clear();
+        b.times.clear();
+        if (timed_)
             for (const ShadowQueue& q : b.per_light)
                 for (const std::int32_t owner : q.owner) b.times.push_back(s.tree.time[std::size_t(owner)]);
-            accel_.occluded_at(options_.secondary_packet, b.all, b.times, b.occluded);
-        } else {
-            accel_.occluded_packets(options_.secondary_packet, b.all, b.occluded);
-        }
+        if (options_.ray_log) options_.ray_log->add(RayLog::Shadow, b.all, b.times);
+        if (timed_) accel_.occluded_at(options_.secondary_packet, b.all, b.times, b.occluded);
+        else accel_.occluded_packets(options_.secondary_packet, b.all, b.occluded);
         std::size_t k = 0;
         for (const ShadowQueue& q : b.per_light)
             for (std::size_t j = 0; j < q.rays.size(); ++j, ++k)

@@ -12,6 +12,7 @@
 #include "accel/accel.h"
 #include "render/film.h"
 #include "render/image.h"
+#include "render/ray_log.h"
 #include "render/ray_offset.h"
 #include "render/sampler.h"
 #include "scene/scene.h"
@@ -62,6 +63,8 @@ struct WhittedOptions {
     /// (from any thread; for progress reports). May be empty.
     void (*progress)(void* context, std::uint64_t pixels_done, std::uint64_t pixels_total) = nullptr;
     void* progress_context = nullptr;
+    /// If set, every ray the render traces is added to it (render --save-rays).
+    RayLog* ray_log = nullptr;
 };
 
 /// Ray counts in the SPD Readme's terms, to compare with its statistics table.

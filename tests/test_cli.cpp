@@ -140,6 +140,54 @@ TEST(Cli, RenderCountsHavransMeasuresOverTheWholeRenderWithTheSameImage) {
     EXPECT_NE(m.output.find("--counts: a moving scene"), std::string::npos) << m.output;
 }
 
+/// --save-rays writes every ray of the render by kind: as many as the
+/// render counts, of the right query, and the render's image unchanged.
+TEST(Cli, RenderSavesTheRaysItTracedByKind) {
+    const fs::path dir = temp_dir(), plain = dir / "plain.png", saving = dir / "saving.png";
+    const std::string prefix = (dir / "balls").string();
+    const std::string common = " --res 64 48 --threads 2 --json";
+    const Result a = run("render gen:balls:2 -o " + plain.string() + common);
+    const Result b = run("render gen:balls:2 -o " + saving.string() + common + " --save-rays " + prefix);
+    ASSERT_EQ(a.status, 0) << a.output;
+    ASSERT_EQ(b.status, 0) << b.output;
+    EXPECT_EQ(slurp(plain), slurp(saving));
+    const nlohmann::json j = nlohmann::json::parse(b.output);
+    const auto& r = j["rays"];
+    ASSERT_EQ(j["saved_rays"].size(), 3u) << b.output;
+    const RayFile eye = read_rays(prefix + "-eye.rays"), bounce = read_rays(prefix + "-bounce.rays"),
+                  shadow = read_rays(prefix + "-shadow.rays");
+    EXPECT_EQ(eye.kind, RayKind::ClosestHit);
+    EXPECT_EQ(bounce.kind, RayKind::ClosestHit);
+    EXPECT_EQ(shadow.kind, RayKind::AnyHit);
+    EXPECT_EQ(eye.rays.size(), r["eye"].get<std::size_t>());
+    EXPECT_EQ(bounce.rays.size(), r["reflect"].get<std::size_t>() + r["refract"].get<std::size_t>());
+    EXPECT_EQ(shadow.rays.size(), r["shadow"].get<std::size_t>());
+    EXPECT_TRUE(eye.times.empty());
+    // The eye rays leave the pinhole, and trace finds the hits the render counted.
+    for (const Rayf& ray : eye.rays) ASSERT_EQ(ray.org, eye.rays[0].org);
+    const Result t = run("trace gen:balls:2 --rays " + prefix + "-eye.rays --repeat 1 --json");
+    ASSERT_EQ(t.status, 0) << t.output;
+    EXPECT_EQ(nlohmann::json::parse(t.output)["hits"], r["eye_hits"]);
+
+    // Path tracing a moving scene: diffuse bounces, and every ray's time.
+    const Result m = run("render gen:balls:1:motion -o " + saving.string() +
+                         " --res 16 16 --integrator path --spp 2 --depth 3 --json --save-rays " + prefix + "-m");
+    ASSERT_EQ(m.status, 0) << m.output;
+    const nlohmann::json jm = nlohmann::json::parse(m.output);
+    const auto& mr = jm["rays"];
+    std::size_t saved = 0;
+    for (const char* kind : {"-m-eye.rays", "-m-bounce.rays", "-m-shadow.rays"}) {
+        const RayFile f = read_rays(prefix + kind);
+        ASSERT_EQ(f.times.size(), f.rays.size()) << kind;
+        for (const float time : f.times) ASSERT_TRUE(time >= 0.0f && time <= 1.0f) << kind;  // gen's shutter
+        saved += f.rays.size();
+    }
+    EXPECT_EQ(saved, mr["eye"].get<std::size_t>() + mr["shadow"].get<std::size_t>() +
+                         mr["reflect"].get<std::size_t>() + mr["refract"].get<std::size_t>() +
+                         mr["diffuse"].get<std::size_t>());
+    EXPECT_GT(mr["diffuse"].get<std::size_t>(), 0u);
+}
+
 TEST(Cli, RenderQuietPrintsNothing) {
     const fs::path out = temp_dir() / "tetra.png";
     fs::remove(out);
@@ -292,6 +340,7 @@ TEST(Cli, BadFlagsAreUsageErrors) {
         {"render " + scene_path("tetra.nff") + " --integrator path --filter mitchell", "--filter: expected box|tent|gaussian"},
         {"render " + scene_path("tetra.nff") + " --integrator distribution --spp 0", "--spp must be between 1 and"},
         {"render " + scene_path("tetra.nff") + " --exposure nan", "--exposure expects a finite number"},
+        {"render " + scene_path("tetra.nff") + " --save-rays ''", "--save-rays: expected a file prefix"},
         {"gen nosuch -o x.nff", "unknown generator 'nosuch'"},
         {"gen balls --size 99 -o x.nff", "--size must be between 1 and"},
         {"frobnicate", "unknown command 'frobnicate'"},
