@@ -30,26 +30,18 @@ void ShadingPoints::add(std::int32_t ray, const Vec3f& view, const Vec3f& ns, co
     cutoff_[j] = specular_cutoff;
 }
 
-void ShadingPoints::add_many(std::size_t n, const std::int32_t* ray, const float* const view[3],
-                             const float* const ns[3], const float* const ng[3], const float* const above[3],
-                             const Material* const* m, const float* specular_cutoff) {
+ShadingPoints::Block ShadingPoints::next_block() {
     if (count_ + kSpare >= ray_.size()) grow();
     const std::size_t j = count_;
-    count_ += n;
-    std::copy(ray, ray + n, &ray_[j]);
+    Block b{&ray_[j], {}, {}, {}, {}, {}, &kd_[j], &ks_[j], &shine_[j], &cutoff_[j]};
     for (int a = 0; a < 3; ++a) {
-        std::copy(view[a], view[a] + n, &view_[a][j]);
-        std::copy(ns[a], ns[a] + n, &ns_[a][j]);
-        std::copy(ng[a], ng[a] + n, &ng_[a][j]);
-        std::copy(above[a], above[a] + n, &above_[a][j]);
+        b.view[a] = &view_[a][j];
+        b.ns[a] = &ns_[a][j];
+        b.ng[a] = &ng_[a][j];
+        b.above[a] = &above_[a][j];
+        b.color[a] = &color_[a][j];
     }
-    for (std::size_t i = 0; i < n; ++i) {
-        for (int a = 0; a < 3; ++a) color_[a][j + i] = m[i]->color[a];
-        kd_[j + i] = m[i]->kd;
-        ks_[j + i] = m[i]->ks;
-        shine_[j + i] = m[i]->shine;
-        cutoff_[j + i] = specular_cutoff[i];
-    }
+    return b;
 }
 
 }  // namespace raypack

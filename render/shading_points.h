@@ -30,11 +30,17 @@ public:
     void add(std::int32_t ray, const Vec3f& view, const Vec3f& ns, const Vec3f& ng, const Vec3f& above,
              const Material& m, float specular_cutoff);
 
-    /// add() for n <= kSpare points at once, their columns given lane by
-    /// lane (arrays of n): the SIMD surface loop's output.
-    void add_many(std::size_t n, const std::int32_t* ray, const float* const view[3], const float* const ns[3],
-                  const float* const ng[3], const float* const above[3], const Material* const* m,
-                  const float* specular_cutoff);
+    /// The columns from the next point on, writable for kSpare points: the
+    /// SIMD surface loop writes a block of points in place, whole vectors
+    /// (entries past the block are written over by the next one), then
+    /// commit(n) takes n of them, n <= kSpare.
+    struct Block {
+        std::int32_t* ray;
+        float *view[3], *ns[3], *ng[3], *above[3], *color[3];
+        float *kd, *ks, *shine, *cutoff;
+    };
+    Block next_block();
+    void commit(std::size_t n) { count_ += n; }
 
     std::int32_t ray(std::size_t j) const { return ray_[j]; }
     Vec3f view(std::size_t j) const { return get(view_, j); }

@@ -69,7 +69,7 @@ struct RayTree {
     }
     /// A new ray (set by the caller through the returned index).
     std::int32_t add() {
-        reserve(count + 1);
+        if (count == rays.size()) reserve(count + 1);  // the call only when full (it was not inlined)
         return std::int32_t(count++);
     }
 
@@ -331,18 +331,18 @@ private:
 
     /// add_point for the rays [begin, end), bit for bit, the hits' view
     /// directions, normals and offset points in SIMD lanes: hits gathered
-    /// K at a time in ray order (so the points keep add_point's order),
-    /// misses and lights' surfaces coloured on the way.
+    /// K at a time in ray order (so the points keep add_point's order) and
+    /// written in place into s.points, misses and lights' surfaces coloured
+    /// on the way.
     void add_points_in_lanes(std::size_t begin, std::size_t end, Scratch& s) const {
         constexpr int K = kShadeLanes;
+        static_assert(K <= int(ShadingPoints::kSpare));
         using F = vfloat<K>;
         RayTree& tree = s.tree;
         alignas(64) float dir[3][K], gn[3][K], sn[3][K], point[3][K];
-        alignas(64) float view[3][K], ns_out[3][K], ng_out[3][K], above[3][K], cutoff[K];
-        std::int32_t ray[K];
         std::uint32_t material[K];
-        const Material* mat[K];
         int n = 0;
+        ShadingPoints::Block out = s.points.next_block();
         const auto flush = [&] {
             for (int l = n; l < K; ++l)  // unused lanes repeat the first
                 for (int a = 0; a < 3; ++a) {
@@ -360,17 +360,13 @@ private:
             const auto front = face_viewer(v, load3(gn), load3(sn), ng, ns);
             const Vec3<F> up = offset_lanes(offset_, load3(point), ng);
             for (int a = 0; a < 3; ++a) {
-                v[a].store_aligned(view[a]);
-                ns[a].store_aligned(ns_out[a]);
-                ng[a].store_aligned(ng_out[a]);
-                up[a].store_aligned(above[a]);
+                store_lanes(out.view[a], v[a]);
+                store_lanes(out.ns[a], ns[a]);
+                store_lanes(out.ng[a], ng[a]);
+                store_lanes(out.above[a], up[a]);
             }
+            s.points.commit(std::size_t(n));
             const std::uint32_t front_bits = mask_bits(front);
-            const float* const columns[4][3] = {{view[0], view[1], view[2]},
-                                                {ns_out[0], ns_out[1], ns_out[2]},
-                                                {ng_out[0], ng_out[1], ng_out[2]},
-                                                {above[0], above[1], above[2]}};
-            s.points.add_many(std::size_t(n), ray, columns[0], columns[1], columns[2], columns[3], mat, cutoff);
             for (int l = 0; l < n; ++l) {
                 SpawnPoint& sp = s.spawn.emplace_back();
                 sp.p.x = point[0][l];
@@ -380,6 +376,7 @@ private:
                 sp.front = (front_bits >> l) & 1u;
             }
             n = 0;
+            out = s.points.next_block();
         };
         for (std::size_t i = begin; i < end; ++i) {
             const Hitf& hit = tree.hits[i];
@@ -401,11 +398,14 @@ private:
                 gn[a][n] = surf.geometric_normal[a];
                 sn[a][n] = surf.shading_normal[a];
                 point[a][n] = surf.point[a];
+                out.color[a][n] = m.color[a];
             }
-            ray[n] = std::int32_t(i);
+            out.ray[n] = std::int32_t(i);
+            out.kd[n] = m.kd;
+            out.ks[n] = m.ks;
+            out.shine[n] = m.shine;
+            out.cutoff[n] = specular_cutoff_[surf.material];
             material[n] = surf.material;
-            mat[n] = &m;
-            cutoff[n] = specular_cutoff_[surf.material];
             if (++n == K) flush();
         }
         if (n > 0) flush();
