@@ -91,14 +91,18 @@ struct AreaLightLanes : LightLanes {
                 for (int a = 0; a < 3; ++a) store_lanes(out_k.point[a], point[a]);
             }
             if (any_lit == 0) continue;
+            std::size_t n = 0;
+            for (int k = 0; k < samples; ++k) n += std::size_t(std::popcount(lanes[std::size_t(k)].lit));
+            const ShadowQueue::Run run = out.append(n);
             // Point by point, sample by sample: the scalar loops' order.
+            std::size_t e = 0;
             for (std::uint32_t bits = any_lit; bits != 0; bits &= bits - 1) {
                 const int i = std::countr_zero(bits);
                 const std::size_t p = j + std::size_t(i);
                 for (int k = 0; k < samples; ++k) {
                     const SampleLanes& in = lanes[std::size_t(k)];
                     if (!((in.lit >> i) & 1u)) continue;
-                    Rayf& ray = out.rays.emplace_back();  // spawn_ray_to, component by component
+                    Rayf& ray = run.rays[e];  // spawn_ray_to, component by component
                     ray.org.x = pts.above_[0][p];
                     ray.org.y = pts.above_[1][p];
                     ray.org.z = pts.above_[2][p];
@@ -107,14 +111,12 @@ struct AreaLightLanes : LightLanes {
                     ray.dir.z = in.point[2][i] - ray.org.z;
                     ray.tnear = offset.tnear();
                     ray.tfar = kShadowRayEnd;
-                    out.owner.push_back(pts.ray_[p]);
-                    Vec3f& c = out.contribution.emplace_back();
-                    c.x = in.contribution[0][i];
-                    c.y = in.contribution[1][i];
-                    c.z = in.contribution[2][i];
-                    ++emitted;
+                    run.owner[e] = pts.ray_[p];
+                    run.contribution[e] = {in.contribution[0][i], in.contribution[1][i], in.contribution[2][i]};
+                    ++e;
                 }
             }
+            emitted += e;
         }
         return emitted;
     }

@@ -31,14 +31,16 @@ struct PointLightLanes : LightLanes {
             const F scale = F(intensity) * atten;
             const Vec3<F> light_color{F(light.color.x) * scale, F(light.color.y) * scale, F(light.color.z) * scale};
             direct(pts, j, faces, ns, l, ns_l, view, light_color, contribution);
-            for (std::uint32_t bits = faces; bits != 0; bits &= bits - 1) {
+            const ShadowQueue::Run run = out.append(std::size_t(std::popcount(faces)));
+            std::size_t k = 0;
+            for (std::uint32_t bits = faces; bits != 0; bits &= bits - 1, ++k) {
                 const int i = std::countr_zero(bits);
                 const std::size_t p = j + std::size_t(i);
-                spawn_ray_to(pts.above(p), light.position, offset, out.rays.emplace_back());
-                out.owner.push_back(pts.ray_[p]);
-                out.contribution.push_back({contribution[0][i], contribution[1][i], contribution[2][i]});
+                spawn_ray_to(pts.above(p), light.position, offset, run.rays[k]);
+                run.owner[k] = pts.ray_[p];
+                run.contribution[k] = {contribution[0][i], contribution[1][i], contribution[2][i]};
             }
-            emitted += std::size_t(std::popcount(faces));
+            emitted += k;
         }
         return emitted;
     }

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "kernels/ray.h"
+#include "render/append_buffer.h"
 #include "render/sampler.h"
 #include "scene/scene.h"
 
@@ -64,9 +65,17 @@ private:
 /// Shadow rays toward one light, each with the ray-tree entry it lights and
 /// the light's contribution there should it be unoccluded.
 struct ShadowQueue {
-    std::vector<Rayf> rays;
-    std::vector<std::int32_t> owner;
-    std::vector<Vec3f> contribution;
+    AppendBuffer<Rayf> rays;
+    AppendBuffer<std::int32_t> owner;
+    AppendBuffer<Vec3f> contribution;
+
+    /// n more rays, each with its owner and contribution: the caller writes them.
+    struct Run {
+        Rayf* rays;
+        std::int32_t* owner;
+        Vec3f* contribution;
+    };
+    Run append(std::size_t n) { return {rays.append(n), owner.append(n), contribution.append(n)}; }
 
     void clear() {
         rays.clear();

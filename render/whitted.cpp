@@ -440,9 +440,10 @@ private:
             if (dot(ns, l) > 0 && dot(ng, l) > 0) {
                 ++s.stats.shadow_rays;
                 ShadowQueue& q = s.shadows.per_light[bucket];
-                spawn_ray(above, l, offset_, q.rays.emplace_back());
-                q.owner.push_back(i);
-                q.contribution.push_back(direct(m, cutoff, light.color * intensity_, ns, l, view));
+                const ShadowQueue::Run run = q.append(1);
+                spawn_ray(above, l, offset_, *run.rays);
+                *run.owner = i;
+                *run.contribution = direct(m, cutoff, light.color * intensity_, ns, l, view);
             }
             ++bucket;
         }

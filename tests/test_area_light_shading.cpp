@@ -44,7 +44,7 @@ void scalar_shading(const Point& p, std::int32_t owner, const AreaLight& light, 
         if (!(dist > 0) || dot(ls.normal, to_light) >= 0) continue;
         const Vec3f l = to_light / dist;
         if (dot(p.ns, l) <= 0 || dot(p.ng, l) <= 0) continue;
-        spawn_ray_to(p.above, ls.point, offset, out.rays.emplace_back());
+        spawn_ray_to(p.above, ls.point, offset, *out.rays.append(1));
         out.owner.push_back(owner);
         const float diffuse = p.m.kd * dot(p.ns, l);
         const Vec3f r = p.ns * (2.0f * dot(p.ns, l)) - l;

@@ -1,0 +1,62 @@
+#pragma once
+// A growable array whose new entries are left for the writer: the light
+// loops append a run of shadow rays at once (append(n)) and write it in
+// place, where std::vector's push_back checks its capacity and moves its end
+// at every entry (three vectors per shadow ray) and resize would write every
+// entry twice.
+#include <cstddef>
+#include <cstring>
+#include <memory>
+#include <new>
+#include <span>
+#include <type_traits>
+
+namespace raypack {
+
+template <class T>
+class AppendBuffer {
+    // Entries are created by writing them (implicit-lifetime types) and
+    // moved by copying bytes.
+    static_assert(std::is_trivially_copyable_v<T> && std::is_trivially_destructible_v<T>);
+
+public:
+    /// n more entries at the end, not initialised: the caller writes them.
+    T* append(std::size_t n) {
+        if (size_ + n > capacity_) grow(size_ + n);
+        T* p = data_.get() + size_;
+        size_ += n;
+        return p;
+    }
+    void push_back(const T& v) { *append(1) = v; }
+    /// Drops entries past the first n (n <= size()).
+    void truncate(std::size_t n) { size_ = n; }
+    void clear() { size_ = 0; }
+
+    std::size_t size() const { return size_; }
+    bool empty() const { return size_ == 0; }
+    T* data() { return data_.get(); }
+    const T* data() const { return data_.get(); }
+    T& operator[](std::size_t i) { return data_.get()[i]; }
+    const T& operator[](std::size_t i) const { return data_.get()[i]; }
+    const T* begin() const { return data(); }
+    const T* end() const { return data() + size_; }
+    operator std::span<const T>() const { return {data(), size_}; }
+
+private:
+    struct Free {
+        void operator()(T* p) const { ::operator delete(p, std::align_val_t(alignof(T))); }
+    };
+    std::unique_ptr<T, Free> data_;
+    std::size_t size_ = 0, capacity_ = 0;
+
+    void grow(std::size_t need) {
+        std::size_t capacity = capacity_ < 64 ? 64 : 2 * capacity_;
+        while (capacity < need) capacity *= 2;
+        T* p = static_cast<T*>(::operator new(capacity * sizeof(T), std::align_val_t(alignof(T))));
+        if (size_ > 0) std::memcpy(static_cast<void*>(p), data_.get(), size_ * sizeof(T));
+        data_.reset(p);
+        capacity_ = capacity;
+    }
+};
+
+}  // namespace raypack
