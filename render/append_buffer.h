@@ -28,8 +28,6 @@ public:
         return p;
     }
     void push_back(const T& v) { *append(1) = v; }
-    /// Drops entries past the first n (n <= size()).
-    void truncate(std::size_t n) { size_ = n; }
     void clear() { size_ = 0; }
 
     std::size_t size() const { return size_; }
