@@ -22,15 +22,32 @@ class AppendBuffer {
 public:
     /// n more entries at the end, not initialised: the caller writes them.
     T* append(std::size_t n) {
-        if (size_ + n > capacity_) grow(size_ + n);
+        if (size_ + n > capacity_) [[unlikely]]
+            grow(size_ + n);
         T* p = data_.get() + size_;
         size_ += n;
         return p;
     }
+    /// append() within room reserve() made: no capacity check.
+    T* append_reserved(std::size_t n) {
+        T* p = data_.get() + size_;
+        size_ += n;
+        return p;
+    }
+    /// Room for n entries in all, so that append_reserved() may follow.
+    void reserve(std::size_t n) {
+        if (n > capacity_) grow(n);
+    }
     void push_back(const T& v) { *append(1) = v; }
     void clear() { size_ = 0; }
+    /// Exactly n entries, not initialised (the caller overwrites them all).
+    T* resize_for_overwrite(std::size_t n) {
+        clear();
+        return append(n);
+    }
 
     std::size_t size() const { return size_; }
+    std::size_t capacity() const { return capacity_; }
     bool empty() const { return size_ == 0; }
     T* data() { return data_.get(); }
     const T* data() const { return data_.get(); }
@@ -38,7 +55,10 @@ public:
     const T& operator[](std::size_t i) const { return data_.get()[i]; }
     const T* begin() const { return data(); }
     const T* end() const { return data() + size_; }
+    T* begin() { return data(); }
+    T* end() { return data() + size_; }
     operator std::span<const T>() const { return {data(), size_}; }
+    operator std::span<T>() { return {data(), size_}; }
 
 private:
     struct Free {
@@ -47,7 +67,8 @@ private:
     std::unique_ptr<T, Free> data_;
     std::size_t size_ = 0, capacity_ = 0;
 
-    void grow(std::size_t need) {
+    // Out of line, so that append() inlines to a compare and an add.
+    [[gnu::noinline]] void grow(std::size_t need) {
         std::size_t capacity = capacity_ < 64 ? 64 : 2 * capacity_;
         while (capacity < need) capacity *= 2;
         T* p = static_cast<T*>(::operator new(capacity * sizeof(T), std::align_val_t(alignof(T))));

@@ -11,6 +11,7 @@
 #include <span>
 #include <vector>
 
+#include "render/append_buffer.h"
 #include "render/camera_rays.h"
 #include "render/camera_samples.h"
 #include "render/film.h"
@@ -36,15 +37,19 @@ float max_component(const Vec3f& v) { return std::max({v.x, v.y, v.z}); }
 /// The live paths of one tile: their next ray, what they carry, and where
 /// their radiance goes.
 struct Paths {
-    std::vector<Rayf> rays;
-    std::vector<Hitf> hits;
-    std::vector<Vec3f> throughput;
-    std::vector<std::uint32_t> sample;  ///< index into the tile's samples (radiance, sampler key)
-    std::vector<std::uint8_t> count_emission;  ///< camera ray, or after a specular bounce
+    // Append buffers, not vectors: a new path's entries are written once,
+    // by the caller, where a vector's resize or emplace_back would
+    // value-initialise them first (rays and hits, which the camera and the
+    // structure overwrite whole, were 6% of the bunny's path render).
+    AppendBuffer<Rayf> rays;
+    AppendBuffer<Hitf> hits;  ///< written by the structure's query
+    AppendBuffer<Vec3f> throughput;
+    AppendBuffer<std::uint32_t> sample;  ///< index into the tile's samples (radiance, sampler key)
+    AppendBuffer<std::uint8_t> count_emission;  ///< camera ray, or after a specular bounce
     /// After a diffuse bounce: its direction's density (solid angle) and
     /// origin, for the MIS weight of emission the ray finds.
-    std::vector<float> bounce_pdf;
-    std::vector<Vec3f> bounce_origin;
+    AppendBuffer<float> bounce_pdf;
+    AppendBuffer<Vec3f> bounce_origin;  ///< read only where bounce_pdf > 0
 
     void clear() {
         rays.clear();
@@ -59,40 +64,84 @@ struct Paths {
     /// Whole arrays at once rather than a push_back per field and path
     /// (with the film change beside it: the bunny's render 5% faster).
     void start_camera_paths(std::size_t n) {
-        clear();
-        rays.resize(n);
-        hits.resize(n);
-        throughput.assign(n, Vec3f{1, 1, 1});
-        sample.resize(n);
-        for (std::size_t i = 0; i < n; ++i) sample[i] = std::uint32_t(i);
-        count_emission.assign(n, 1);
-        bounce_pdf.assign(n, 0.0f);
-        bounce_origin.resize(n);
+        rays.resize_for_overwrite(n);
+        hits.resize_for_overwrite(n);
+        bounce_origin.resize_for_overwrite(n);
+        std::fill_n(throughput.resize_for_overwrite(n), n, Vec3f{1, 1, 1});
+        std::uint32_t* samples = sample.resize_for_overwrite(n);
+        for (std::size_t i = 0; i < n; ++i) samples[i] = std::uint32_t(i);
+        std::fill_n(count_emission.resize_for_overwrite(n), n, std::uint8_t(1));
+        std::fill_n(bounce_pdf.resize_for_overwrite(n), n, 0.0f);
     }
-    /// A new path whose ray the caller writes in place (a Rayf built on the
-    /// stack and copied stalls on store forwarding: 13% of a path-traced
-    /// Cornell box). `origin`: where a diffuse bounce left (read only when
-    /// pdf > 0).
+    /// Room for n more paths, for append_reserved().
+    void reserve_more(std::size_t n) {
+        const std::size_t need = rays.size() + n;
+        if (need <= rays.capacity()) [[likely]]
+            return;
+        rays.reserve(need);
+        hits.reserve(need);
+        throughput.reserve(need);
+        sample.reserve(need);
+        count_emission.reserve(need);
+        bounce_pdf.reserve(need);
+        bounce_origin.reserve(need);
+    }
+    /// One more path within reserve_more()'s room, every entry but its hit
+    /// left for the caller to write (a Rayf built on the stack and copied
+    /// stalls on store forwarding: 13% of a path-traced Cornell box);
+    /// returns its index.
+    RAYPACK_INLINE std::size_t append_reserved() {
+        const std::size_t k = rays.size();
+        rays.append_reserved(1);
+        hits.append_reserved(1);
+        throughput.append_reserved(1);
+        sample.append_reserved(1);
+        count_emission.append_reserved(1);
+        bounce_pdf.append_reserved(1);
+        bounce_origin.append_reserved(1);
+        return k;
+    }
+    /// A new path whose ray the caller writes in place. `origin`: where a
+    /// diffuse bounce left (read only when pdf > 0).
     Rayf& add(const Vec3f& beta, std::uint32_t s, bool emission, float pdf = 0, const Vec3f& origin = {}) {
-        bounce_pdf.push_back(pdf);
-        bounce_origin.push_back(origin);
-        hits.emplace_back();
-        throughput.push_back(beta);
-        sample.push_back(s);
-        count_emission.push_back(emission);
-        return rays.emplace_back();
+        reserve_more(1);
+        const std::size_t k = append_reserved();
+        throughput[k] = beta;
+        sample[k] = s;
+        count_emission[k] = emission;
+        bounce_pdf[k] = pdf;
+        bounce_origin[k] = origin;
+        return rays[k];
     }
 };
 
 struct Shadows {
-    std::vector<Rayf> rays;
-    std::vector<std::uint32_t> sample;
-    std::vector<Vec3f> contribution;
-    std::vector<std::uint8_t> occluded;
+    AppendBuffer<Rayf> rays;
+    AppendBuffer<std::uint32_t> sample;
+    AppendBuffer<Vec3f> contribution;
+    AppendBuffer<std::uint8_t> occluded;  ///< written by the structure's query
     void clear() {
         rays.clear();
         sample.clear();
         contribution.clear();
+    }
+    /// Room for n more shadow rays, for append_reserved().
+    void reserve_more(std::size_t n) {
+        const std::size_t need = rays.size() + n;
+        if (need <= rays.capacity()) [[likely]]
+            return;
+        rays.reserve(need);
+        sample.reserve(need);
+        contribution.reserve(need);
+    }
+    /// One more shadow ray within reserve_more()'s room, for the caller to
+    /// write; returns its index.
+    RAYPACK_INLINE std::size_t append_reserved() {
+        const std::size_t k = rays.size();
+        rays.append_reserved(1);
+        sample.append_reserved(1);
+        contribution.append_reserved(1);
+        return k;
     }
 };
 
@@ -603,26 +652,29 @@ private:
             const std::uint32_t si = p.sample[i];
             if ((lit_bits >> l) & 1u) {
                 ++s.stats.shadow_rays;
-                Rayf& ray = s.shadows.rays.emplace_back();  // spawn_ray / spawn_ray_to
+                s.shadows.reserve_more(1);  // one_by_one's shadow rays take room too
+                const std::size_t k = s.shadows.append_reserved();
+                Rayf& ray = s.shadows.rays[k];  // spawn_ray / spawn_ray_to
                 set(ray.org, above_l, l);
                 set(ray.dir, shadow_dir, l);
                 ray.tnear = offset_.tnear();
                 ray.tfar = kind[l] == kDistant ? std::numeric_limits<float>::infinity() : kShadowRayEnd;
-                s.shadows.sample.push_back(si);
-                set(s.shadows.contribution.emplace_back(), contribution_l, l);
+                s.shadows.sample[k] = si;
+                set(s.shadows.contribution[k], contribution_l, l);
             }
             if (!((alive >> l) & 1u)) continue;
             if (specular) ++s.stats.reflect_rays;
             else ++s.stats.diffuse_rays;
             // Paths::add(next beta, si, specular, bounce pdf, origin) and spawn_ray.
             Paths& next = s.next;
-            next.bounce_pdf.push_back(bounce_pdf_l[l]);
-            set(next.bounce_origin.emplace_back(), above_l, l);
-            next.hits.emplace_back();
-            set(next.throughput.emplace_back(), next_beta_l, l);
-            next.sample.push_back(si);
-            next.count_emission.push_back(specular);
-            Rayf& ray = next.rays.emplace_back();
+            next.reserve_more(1);
+            const std::size_t k = next.append_reserved();
+            next.bounce_pdf[k] = bounce_pdf_l[l];
+            set(next.bounce_origin[k], above_l, l);
+            set(next.throughput[k], next_beta_l, l);
+            next.sample[k] = si;
+            next.count_emission[k] = specular;
+            Rayf& ray = next.rays[k];
             set(ray.org, above_l, l);
             set(ray.dir, out_dir_l, l);
             ray.tnear = offset_.tnear();
@@ -693,17 +745,19 @@ private:
             target = ls.point;
         }
         ++s.stats.shadow_rays;
-        Rayf& r = s.shadows.rays.emplace_back();  // written in place, as Paths::add's rays
+        s.shadows.reserve_more(1);
+        const std::size_t k = s.shadows.append_reserved();
+        Rayf& r = s.shadows.rays[k];  // written in place, as Paths::add's rays
         if (distant) spawn_ray(above, wi_distant, offset_, r);
         else spawn_ray_to(above, target, offset_, r);
-        s.shadows.sample.push_back(si);
-        s.shadows.contribution.push_back(contribution);
+        s.shadows.sample[k] = si;
+        s.shadows.contribution[k] = contribution;
     }
 
     void trace_shadows(Scratch& s) const {
         Shadows& b = s.shadows;
         if (b.rays.empty()) return;
-        b.occluded.resize(b.rays.size());
+        b.occluded.resize_for_overwrite(b.rays.size());
         const auto times = timed_ ? times_of(b.sample, s) : std::span<const float>{};
         if (options_.ray_log) options_.ray_log->add(RayLog::Shadow, b.rays, times);
         if (timed_) accel_.occluded_at(options_.secondary_packet, b.rays, times, b.occluded);

@@ -11,8 +11,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <iomanip>
+#include <limits>
 #include <random>
 #include <sstream>
 #include <string>
@@ -335,6 +337,72 @@ TEST_F(AccelOracle, BuildAccelTimesEveryStructure) {
         const Scene scene = load_scene(spec);
         EXPECT_TRUE(scene.placements() || !scene.moving_instances.empty()) << spec;
         EXPECT_GT(build_accel(scene, accel_config("bvh4"))->stats().build_ms, 0.0) << spec;
+    }
+}
+
+TEST_F(AccelOracle, QueriesWriteEveryAnswer) {
+    // The renderers hand the structures hit and occlusion buffers they have
+    // not initialised (render/append_buffer.h): every query must write every
+    // answer, misses included. Buffers filled with a poison that looks like
+    // a hit on primitive 0 must come back as fresh ones do, bit for bit, for
+    // every structure, query, packet width and kind of scene.
+    Hitf poison;
+    poison.t = -7.0f;
+    poison.prim = 0;
+    poison.u = poison.v = std::numeric_limits<float>::quiet_NaN();
+    const auto same = [](const Hitf& a, const Hitf& b) {
+        return std::memcmp(&a, &b, sizeof(Hitf)) == 0;
+    };
+    for (const char* spec : {"gen:balls:2", "gen:teapot:4", "gen:tetra-instanced:3", "gen:balls:2:motion"}) {
+        const Scene scene = load_scene(spec);
+        std::vector<Rayf> rays = camera_rays(scene, 24);
+        for (std::size_t i = 0; i < rays.size(); i += 3) rays[i].dir = -rays[i].dir;  // away from the scene: misses
+        std::vector<Hitf> first(rays.size());
+        build_accel(scene, accel_config("brute"))->intersect(rays, first);
+        const std::vector<Rayf> shadows = shadow_rays(scene, rays, first);
+        const auto times_for = [](std::size_t n) {
+            std::vector<float> t(n);
+            for (std::size_t i = 0; i < n; ++i) t[i] = float(i % 7) / 6.0f;
+            return t;
+        };
+        const std::vector<float> times = times_for(rays.size()), shadow_times = times_for(shadows.size());
+        for (const char* kind : accel_kinds()) {
+            SCOPED_TRACE(std::string(spec) + " " + kind);
+            const bool embree = std::string(kind).starts_with("embree");
+            if (embree && (scene.placements() || !scene.moving_instances.empty())) continue;  // raypack's own only
+            const std::unique_ptr<Accel> accel = build_accel(scene, accel_config(kind));
+            for (int width : {1, 4, 8, 16}) {
+                if (width > 1 && !accel->supports_packet(width)) continue;
+                for (const bool timed : {false, true}) {
+                    std::vector<Hitf> fresh(rays.size()), dirty(rays.size(), poison);
+                    std::vector<std::uint8_t> open(shadows.size()), smudged(shadows.size(), 0xAB);
+                    if (timed) {
+                        accel->intersect_at(width, rays, times, fresh);
+                        accel->intersect_at(width, rays, times, dirty);
+                        accel->occluded_at(width, shadows, shadow_times, open);
+                        accel->occluded_at(width, shadows, shadow_times, smudged);
+                    } else if (width == 1) {
+                        accel->intersect(rays, fresh);
+                        accel->intersect(rays, dirty);
+                        accel->occluded(shadows, open);
+                        accel->occluded(shadows, smudged);
+                    } else {
+                        accel->intersect_packets(width, rays, fresh);
+                        accel->intersect_packets(width, rays, dirty);
+                        accel->occluded_packets(width, shadows, open);
+                        accel->occluded_packets(width, shadows, smudged);
+                    }
+                    std::size_t misses = 0, unwritten = 0;
+                    for (std::size_t i = 0; i < rays.size(); ++i) {
+                        misses += !fresh[i].found();
+                        unwritten += !same(fresh[i], dirty[i]);
+                    }
+                    EXPECT_GT(misses, 0u) << "width " << width;  // the poison is tested on misses too
+                    EXPECT_EQ(unwritten, 0u) << "width " << width << (timed ? " at times" : "");
+                    EXPECT_EQ(open, smudged) << "width " << width << (timed ? " at times" : "");
+                }
+            }
+        }
     }
 }
 
