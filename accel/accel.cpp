@@ -172,8 +172,16 @@ std::unique_ptr<Accel> build_one(const Scene& scene, const AccelConfig& config) 
 #endif
     if (config.kind == "grid") return std::make_unique<GridAccel>(scene, config);
     if (config.kind == "grid2") return std::make_unique<Grid2Accel>(scene, config);
-    if (config.kind == "kdtree") return std::make_unique<KdTreeAccel>(scene, config);
-    if (config.kind == "octree") return std::make_unique<OctreeAccel>(scene, config);
+    if (config.kind == "kdtree") {
+        KdTreeConfig kd;
+        kd.packet_groups = config.packet_group != 1;
+        return std::make_unique<KdTreeAccel>(scene, config, kd);
+    }
+    if (config.kind == "octree") {
+        OctreeConfig oc;
+        oc.packet_groups = config.packet_group != 1;
+        return std::make_unique<OctreeAccel>(scene, config, oc);
+    }
     if (config.kind == "brute") return std::make_unique<BruteForce>(scene, config.kernels);
 #ifdef RAYPACK_HAVE_EMBREE
     if (is_embree_kind(config.kind))

@@ -130,4 +130,17 @@ void trace_in_groups(std::span<const Rayf> rays, std::span<Hitf> hits, RcpMethod
     if (count != 0) flush();
 }
 
+/// trace_in_groups for walks that may decline a group: `trace_group(packets,
+/// count)` returns false, tracing nothing, when the group's packets cannot
+/// share its walk (k-d tree: not from one point; octree: not one direction
+/// octant), and each is then traced alone with `trace_packet`.
+template <int K, int G, bool AnyHit, class MayLead, class TracePacket, class TraceGroup>
+void trace_in_groups_or_alone(std::span<const Rayf> rays, std::span<Hitf> hits, RcpMethod rcp, MayLead&& may_lead,
+                              TracePacket&& trace_packet, TraceGroup&& trace_group) {
+    trace_in_groups<K, G, AnyHit>(rays, hits, rcp, may_lead, trace_packet, [&](LoadedPacket<K>* p, int count) {
+        if (count > 1 && trace_group(p, count)) return;
+        for (int q = 0; q < count; ++q) trace_packet(p[q].ray, p[q].hit, p[q].valid, p[q].occluded);
+    });
+}
+
 }  // namespace raypack

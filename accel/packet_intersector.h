@@ -19,6 +19,12 @@ struct PacketPrimitiveIntersector {
 
     /// Lanes of `valid` that hit primitive `prim` within [tnear, tfar]:
     /// records the hit in those lanes of `hit` and shrinks their tfar.
+    /// LowestOnTies: a lane whose hit so far lies at exactly the same t on a
+    /// primitive of lower number keeps it (the tie rule of the walks whose
+    /// lanes test primitives in another order than their single rays,
+    /// accel/packet_ties.h); checked before the hit is recorded, so the
+    /// common case pays one compare.
+    template <bool LowestOnTies = false>
     RAYPACK_INLINE mask_of<F> intersect(mask_of<F> valid, RayLanes<F>& ray, HitLanes<F>& hit,
                                         std::uint32_t prim) const {
         if (kernels.precision == Precision::Double) return intersect_lanes_in_double(valid, ray, hit, prim);
@@ -26,7 +32,7 @@ struct PacketPrimitiveIntersector {
         F t, u(0.0f), v(0.0f);
         std::uint32_t ids[lanes_of<F>];
         bool named = false;
-        const mask_of<F> m = PrimKinds::dispatch(ref.kind, [&]<class Kind>() RAYPACK_INLINE_LAMBDA {
+        mask_of<F> m = PrimKinds::dispatch(ref.kind, [&]<class Kind>() RAYPACK_INLINE_LAMBDA {
             if constexpr (names_hits<Kind>) {
                 named = true;
                 return Kind::template intersect<F>(*scene, ref.index, kernels, valid, ray, t, u, v, ids);
@@ -35,6 +41,20 @@ struct PacketPrimitiveIntersector {
             }
         });
         if (none(m)) return m;
+        if constexpr (LowestOnTies) {
+            // Lanes at the same t on another primitive (a primitive met again
+            // in a later leaf ties with itself, often: filtered here, not in
+            // the out-of-line call).
+            std::uint32_t other = 0;
+            for (std::uint32_t b = mask_bits(m & (t == hit.t)); b != 0; b &= b - 1) {
+                const int l = std::countr_zero(b);
+                other |= hit.prim[l] != (named ? ids[l] : prim) ? 1u << l : 0u;
+            }
+            if (other != 0) [[unlikely]] {
+                m = m & !lower_already(other, hit, named ? ids : nullptr, prim);
+                if (none(m)) return m;
+            }
+        }
         hit.t = select(m, t, hit.t);
         hit.u = select(m, u, hit.u);
         hit.v = select(m, v, hit.v);
@@ -55,6 +75,17 @@ struct PacketPrimitiveIntersector {
     }
 
 private:
+    /// The lanes of `bits` whose hit so far is on a primitive numbered below
+    /// this one's (ids: per lane, or null for `prim` in every lane).
+    [[gnu::noinline, gnu::cold]] static mask_of<F> lower_already(std::uint32_t bits, const HitLanes<F>& hit,
+                                                                 const std::uint32_t* ids, std::uint32_t prim) {
+        constexpr int K = lanes_of<F>;
+        alignas(64) float lower[K];
+        for (int l = 0; l < K; ++l)
+            lower[l] = ((bits >> l) & 1u) && hit.prim[l] < (ids ? ids[l] : prim) ? 1.0f : 0.0f;
+        return load_lanes<F>(lower) != F(0.0f);
+    }
+
     /// --precision double: the active lanes one by one through the scalar
     /// double test (there is no double packet kernel; double is the
     /// reference, not the fast path).

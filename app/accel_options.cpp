@@ -79,7 +79,8 @@ std::string accel_options_help() {
            + kernel_options_help() +
            "  --packet 1|4|8|16             rays per packet (default 1; 16 needs AVX-512)\n"
            "  --group G                     bvh4|bvh8: packets that walk the tree together when their\n"
-           "                rays share a direction octant (default 128 rays' worth; 1: each alone)\n";
+           "                rays share a direction octant (default 128 rays' worth; 1: each alone);\n"
+           "                kdtree|octree: 1 makes each packet walk alone (default: groups of 16 / 8)\n";
 }
 
 std::vector<OptionSpec> kernel_option_specs() {
@@ -124,8 +125,12 @@ AccelConfig accel_config_from(const ParsedArgs& args) {
     }
     if (args.has("--group")) {
         config.packet_group = int(args.integer("--group", 1, 1, WidePacketConfig::kMaxGroupPackets));
-        if (!uses_fastest_config(args) && config.kind != "bvh4" && config.kind != "bvh8")
-            throw UsageError("--group applies to bvh4 and bvh8 only, not to --accel " + config.kind);
+        const bool fixed_groups = config.kind == "kdtree" || config.kind == "octree";
+        if (fixed_groups && config.packet_group != 1)
+            throw UsageError("--group: " + config.kind +
+                             " packets walk in groups of a fixed size; only --group 1 (each packet alone) applies");
+        if (!uses_fastest_config(args) && config.kind != "bvh4" && config.kind != "bvh8" && !fixed_groups)
+            throw UsageError("--group applies to bvh4, bvh8, kdtree and octree only, not to --accel " + config.kind);
     }
     config.kernels = kernel_choice_from(args);
     config.build_quality = embree_quality_from(args, config.kind);

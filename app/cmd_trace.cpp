@@ -13,6 +13,8 @@
 #include "app/commands.h"
 #include "app/default_config.h"
 #include "accel/bvh/wide_packet.h"
+#include "accel/kdtree/kdtree_packet.h"
+#include "accel/octree/octree_packet.h"
 #include "scene/load.h"
 #include "scene/ray_file.h"
 
@@ -104,9 +106,16 @@ int run_trace(const Args& args) {
         j["accel"] = as.name;
         j["builder"] = as.builder;
         j["packet"] = packet;
-        // Packets per shared walk (bvh4, bvh8 with packets; 1: alone).
+        // Packets per shared walk, at most (1: alone). The k-d tree groups
+        // rays from one point in float precision, the octree rays of one
+        // octant; both keep the rest alone.
         const bool wide = (as.name == "bvh4" || as.name == "bvh8") && packet > 1;
-        j["group"] = !wide ? 1 : config.packet_group > 0 ? config.packet_group : default_wide_packet_config(4, packet).group_packets;
+        const bool cells = (as.name == "kdtree" || as.name == "octree") && packet > 1 && config.packet_group != 1 &&
+                           config.kernels.precision == Precision::Float;
+        j["group"] = wide    ? (config.packet_group > 0 ? config.packet_group
+                                                        : default_wide_packet_config(4, packet).group_packets)
+                     : cells ? (as.name == "kdtree" ? kKdGroupPackets : kOctreeGroupPackets)
+                             : 1;
         j["triangle"] = triangle_method_name(config.kernels.triangle);
         j["sphere"] = sphere_method_name(config.kernels.sphere);
         j["slabs"] = slab_method_name(config.kernels.slabs);

@@ -3,11 +3,14 @@
 // octree, k-d tree) share: the hand-made scenes they are all held to brute
 // force on, and the rays built from each structure's own planes that make its
 // walk stumble (the grid's are in tests/grid_test_rays.h).
+#include <cmath>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <random>
 #include <vector>
 
+#include "accel/accel.h"
 #include "accel/kdtree/kdtree.h"
 #include "accel/octree/octree.h"
 #include "scene/scene.h"
@@ -278,6 +281,56 @@ inline std::vector<Rayf> kdtree_adversarial_rays(const raypack::KdTree& tree, co
         rays.push_back(r);
     }
     return rays;
+}
+
+// ---- Packets in groups ------------------------------------------------------------------
+
+/// The rays the group walks (k-d tree, octree) are held to their packets
+/// alone and to single rays with: `rays` (camera rays, whose hits are
+/// `hits`), then 512 rays from a point inside the scene in each direction
+/// octant and 512 in mixed octants, then rays from the first light to the
+/// camera rays' hits (one origin, many ends; for occlusion).
+inline std::vector<Rayf> packet_group_rays(const Scene& scene, std::vector<Rayf> rays, const std::vector<Hitf>& hits,
+                                           unsigned seed) {
+    std::vector<Rayf> from_light;
+    const Vec3f light = scene.lights.empty() ? scene.camera.from : scene.lights.front().position;
+    for (std::size_t i = 0; i < hits.size(); ++i)
+        if (hits[i].found()) from_light.push_back(Rayf{light, rays[i].org + rays[i].dir * hits[i].t - light, 0.0f, 0.999f});
+    std::mt19937 rng(seed);
+    const Box3f box = scene_bounds(scene);
+    const Vec3f inside = box.lo + box.extent() * 0.37f;
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    for (int octant = 0; octant < 9; ++octant)  // 8 one-octant runs, then mixed directions
+        for (int i = 0; i < 512; ++i) {
+            Vec3f d{std::fabs(u(rng)), std::fabs(u(rng)), std::fabs(u(rng))};
+            for (int a = 0; a < 3; ++a)
+                if (octant == 8 ? u(rng) < 0.0f : ((octant >> a) & 1) != 0) d[a] = -d[a];
+            rays.push_back(Rayf{inside, d, 0.0f, std::numeric_limits<float>::infinity()});
+        }
+    rays.insert(rays.end(), from_light.begin(), from_light.end());
+    return rays;
+}
+
+/// How many of `rays`' closest hits or occlusion answers in packets of
+/// `width` differ, bit for bit, between a structure walking packets in
+/// groups and the same structure walking them alone, and between it and its
+/// single rays.
+struct GroupDifferences {
+    std::size_t against_alone = 0, against_single = 0;
+};
+inline GroupDifferences group_differences(const Accel& grouped, const Accel& alone, const std::vector<Rayf>& rays,
+                                          int width) {
+    const std::vector<Hitf> single = trace_hits(grouped, rays), got = trace_hits(grouped, rays, width),
+                            want = trace_hits(alone, rays, width);
+    const std::vector<std::uint8_t> single_occ = trace_occlusion(grouped, rays),
+                                    got_occ = trace_occlusion(grouped, rays, width),
+                                    want_occ = trace_occlusion(alone, rays, width);
+    GroupDifferences d;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        d.against_alone += !same_bits(got[i], want[i]) || got_occ[i] != want_occ[i];
+        d.against_single += !same_bits(got[i], single[i]) || got_occ[i] != single_occ[i];
+    }
+    return d;
 }
 
 }  // namespace raypack::cell_test_cases

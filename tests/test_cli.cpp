@@ -307,6 +307,19 @@ TEST(Cli, TraceDefaultsToTheFastestConfigurationForTheRays) {
     EXPECT_TRUE(jg["default_config"].get<bool>());
     EXPECT_EQ(jg["group"].get<int>(), 2);
     EXPECT_EQ(run("trace " + scene + " --rays " + rays + " --group 2 --accel grid --packet 8").status, 2);
+    // The k-d tree and the octree group a fixed number of packets; --group 1
+    // makes each walk alone, with the same hits.
+    for (const auto& [kind, group] : {std::pair{"kdtree", 16}, std::pair{"octree", 8}}) {
+        const std::string base = "trace " + scene + " --rays " + rays + " --repeat 1 --json --packet 8 --accel " + kind;
+        const Result grouped = run(base), alone = run(base + " --group 1");
+        ASSERT_EQ(grouped.status, 0) << grouped.output;
+        ASSERT_EQ(alone.status, 0) << alone.output;
+        const auto jgr = nlohmann::json::parse(grouped.output), jal = nlohmann::json::parse(alone.output);
+        EXPECT_EQ(jgr["group"].get<int>(), group) << kind;
+        EXPECT_EQ(jal["group"].get<int>(), 1) << kind;
+        EXPECT_EQ(jgr["hits"], jal["hits"]) << kind;
+        EXPECT_EQ(run(base + " --group 2").status, 2) << kind;
+    }
     EXPECT_EQ(run("trace " + scene + " --rays " + rays + " --group 17").status, 2);
 }
 

@@ -164,42 +164,15 @@ TEST_P(KdTree, PacketGroupsGiveThePacketsAnswers) {
     alone_config.packet_groups = false;
     const auto grouped = make_tree(scene), alone = make_tree(scene, alone_config);
     const BruteForce brute(scene, KernelChoice{});
-    std::vector<Rayf> rays = camera_rays(scene, 64);
-    std::vector<Rayf> from_light;
-    const std::vector<Hitf> camera_hits = trace_hits(brute, rays);
-    const Vec3f light = scene.lights.empty() ? scene.camera.from : scene.lights.front().position;
-    for (std::size_t i = 0; i < rays.size(); ++i)
-        if (camera_hits[i].found()) {
-            const Vec3f end = rays[i].org + rays[i].dir * camera_hits[i].t;
-            from_light.push_back(Rayf{light, end - light, 0.0f, 0.999f});
-        }
-    std::mt19937 rng(41);
-    const Box3f box = scene_bounds(scene);
-    const Vec3f inside = box.lo + box.extent() * 0.37f;
-    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
-    for (int octant = 0; octant < 9; ++octant)  // 8 one-octant runs, then mixed directions
-        for (int i = 0; i < 512; ++i) {
-            Vec3f d{std::fabs(u(rng)), std::fabs(u(rng)), std::fabs(u(rng))};
-            for (int a = 0; a < 3; ++a)
-                if (octant == 8 ? u(rng) < 0.0f : ((octant >> a) & 1) != 0) d[a] = -d[a];
-            rays.push_back(Rayf{inside, d, 0.0f, std::numeric_limits<float>::infinity()});
-        }
-    rays.insert(rays.end(), from_light.begin(), from_light.end());
-    const std::vector<Hitf> single = trace_hits(*grouped, rays);
-    const std::vector<std::uint8_t> single_occ = trace_occlusion(*grouped, rays);
+    const std::vector<Rayf> camera = camera_rays(scene, 64);
+    const std::vector<Rayf> rays = packet_group_rays(scene, camera, trace_hits(brute, camera), 41);
     int checked = 0;
     for (int width : {4, 8, 16}) {
         if (!grouped->supports_packet(width)) continue;
         ++checked;
-        const std::vector<Hitf> got = trace_hits(*grouped, rays, width), want = trace_hits(*alone, rays, width);
-        const std::vector<std::uint8_t> got_occ = trace_occlusion(*grouped, rays, width);
-        std::size_t differ = 0, differ_single = 0;
-        for (std::size_t i = 0; i < rays.size(); ++i) {
-            differ += !same_bits(got[i], want[i]);
-            differ_single += !same_bits(got[i], single[i]) || got_occ[i] != single_occ[i];
-        }
-        EXPECT_EQ(differ, 0u) << GetParam() << " width " << width << ": grouped against alone";
-        EXPECT_EQ(differ_single, 0u) << GetParam() << " width " << width << ": grouped against single rays";
+        const GroupDifferences d = group_differences(*grouped, *alone, rays, width);
+        EXPECT_EQ(d.against_alone, 0u) << GetParam() << " width " << width << ": grouped against alone";
+        EXPECT_EQ(d.against_single, 0u) << GetParam() << " width " << width << ": grouped against single rays";
     }
     EXPECT_GE(checked, 1);
 }

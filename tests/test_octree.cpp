@@ -195,6 +195,27 @@ TEST_P(Octree, MatchesBruteForce) {
     RecordProperty("refs_per_prim", std::to_string(octree.references_per_primitive()));
 }
 
+// Packets of one direction octant walk in groups (octree_packet.cpp,
+// trace_group): the same answers, bit for bit, as every packet alone and as
+// single rays (the tie rule makes them independent of the leaves' order),
+// for camera rays, for rays from a point inside the scene in each octant and
+// in mixed octants, and, for occlusion, for rays from the first light to the
+// camera rays' hits, at every compiled width.
+TEST_P(Octree, PacketGroupsGiveThePacketsAnswers) {
+    const Scene scene = load_scene(std::string(RAYPACK_SOURCE_DIR) + "/scenes/" + GetParam());
+    OctreeConfig alone_config;
+    alone_config.packet_groups = false;
+    const auto grouped = make_octree(scene), alone = make_octree(scene, alone_config);
+    const BruteForce brute(scene, KernelChoice{});
+    const std::vector<Rayf> camera = tiled_camera_rays(scene, 64);
+    const std::vector<Rayf> rays = packet_group_rays(scene, camera, trace(brute, camera), 43);
+    for (int width : packet_widths()) {
+        const GroupDifferences d = group_differences(*grouped, *alone, rays, width);
+        EXPECT_EQ(d.against_alone, 0u) << GetParam() << " width " << width << ": grouped against alone";
+        EXPECT_EQ(d.against_single, 0u) << GetParam() << " width " << width << ": grouped against single rays";
+    }
+}
+
 INSTANTIATE_TEST_SUITE_P(, Octree, ::testing::ValuesIn(shared_scene_files()), param_name);
 
 // ---- Hand-made scenes -----------------------------------------------------------------

@@ -84,7 +84,7 @@ bool KdTreeAccel::walk(Rayf& ray, Hitf& hit, KdRayCounters* counters) const {
     if (tree_.empty()) return false;
     const Vec3f rdir = ray_reciprocal(ray.dir, kernels_.rcp);
     float tmin, tmax;
-    if (!kd_ray_interval<float, Slabs>(true, ray.org, rdir, ray.tnear, ray.tfar, tree_.bounds, tree_.margin, tmin,
+    if (!ray_box_interval<float, Slabs>(true, ray.org, rdir, ray.tnear, ray.tfar, tree_.bounds, tree_.margin, tmin,
                                        tmax))
         return false;
     constexpr bool plain = Slabs == SlabMethod::Plain;

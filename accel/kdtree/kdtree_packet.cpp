@@ -10,43 +10,15 @@
 #include "accel/packet_driver.h"
 #include "accel/packet_intersector.h"
 #include "accel/packet_mailbox.h"
+#include "accel/packet_ties.h"
 #include "kernels/ray_packet.h"
 
 namespace raypack {
 namespace {
 
-/// Lanes of `tie` hit prim at exactly the t they had before: restore the
-/// earlier hit where its primitive number is lower. Rare, hence out of line:
-/// a call on the common path makes every live vector register spill.
-template <int K>
-[[gnu::noinline, gnu::cold]] void keep_lowest_on_ties(const vmask<K>& tie, const HitPacket<K>& before,
-                                                      HitPacket<K>& hit, std::uint32_t prim) {
-    std::uint32_t bits = mask_bits(tie);
-    // t too: +0 == -0, and the earlier hit keeps its own sign of zero.
-    alignas(64) float t[K], u[K], v[K], bt[K], bu[K], bv[K];
-    store_lanes(t, hit.t), store_lanes(u, hit.u), store_lanes(v, hit.v);
-    store_lanes(bt, before.t), store_lanes(bu, before.u), store_lanes(bv, before.v);
-    for (; bits; bits &= bits - 1) {
-        const int l = std::countr_zero(bits);
-        if (before.prim[l] < prim) hit.prim[l] = before.prim[l], t[l] = bt[l], u[l] = bu[l], v[l] = bv[l];
-    }
-    hit.t = load_lanes<vfloat<K>>(t);
-    hit.u = load_lanes<vfloat<K>>(u);
-    hit.v = load_lanes<vfloat<K>>(v);
-}
-
 template <class F>
 RAYPACK_INLINE F select_if(bool c, const F& a, const F& b) {
     return c ? a : b;
-}
-
-/// Some lane of `tie_bits` had its hit on another primitive than `prim`
-/// (a primitive tested again in a later leaf ties with itself, often).
-template <int K>
-RAYPACK_INLINE bool ties_another_primitive(std::uint32_t tie_bits, const HitPacket<K>& before, std::uint32_t prim) {
-    for (; tie_bits; tie_bits &= tie_bits - 1)
-        if (before.prim[std::countr_zero(tie_bits)] != prim) return true;
-    return false;
 }
 
 /// The lanes of `m` get back their hit from `before`.
@@ -315,7 +287,7 @@ bool trace_group(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>>
     for (int q = 0; q < count; ++q) {
         const RayPacket<K>& ray = p[q].ray;
         F t0, t1;
-        const M in = kd_ray_interval<F>(p[q].valid, ray.org, ray.rdir, ray.tnear, ray.tfar, tree.bounds, tree.margin,
+        const M in = ray_box_interval<F>(p[q].valid, ray.org, ray.rdir, ray.tnear, ray.tfar, tree.bounds, tree.margin,
                                         t0, t1);
         lanes[q] = in;
         const std::uint32_t bits = mask_bits(in);
@@ -464,7 +436,7 @@ bool trace_group(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>>
                 const int q = std::countr_zero(b);
                 RayPacket<K>& ray = p[q].ray;
                 F t0, t1;
-                const M in = kd_ray_interval<F>(lanes[q], ray.org, ray.rdir, ray.tnear, ray.tfar, cell,
+                const M in = ray_box_interval<F>(lanes[q], ray.org, ray.rdir, ray.tnear, ray.tfar, cell,
                                                 2.0f * tree.margin, t0, t1);
                 if (none(in)) continue;
                 if (culled)
@@ -518,7 +490,7 @@ void kdtree_trace_packets(const KdTree& tree, const Scene& scene, KernelChoice k
         const auto trace_one = [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid, vmask<K>& occluded) {
             if (tree.empty()) return;
             vfloat<K> tmin, tmax;
-            const vmask<K> in_box = kd_ray_interval<vfloat<K>, Slabs>(valid, ray.org, ray.rdir, ray.tnear, ray.tfar,
+            const vmask<K> in_box = ray_box_interval<vfloat<K>, Slabs>(valid, ray.org, ray.rdir, ray.tnear, ray.tfar,
                                                                       tree.bounds, tree.margin, tmin, tmax);
             const std::uint32_t lanes = mask_bits(in_box);
             if (!lanes) return;
@@ -533,12 +505,9 @@ void kdtree_trace_packets(const KdTree& tree, const Scene& scene, KernelChoice k
         if constexpr (Slabs == SlabMethod::Robust) {
             if (groups && !tree.empty() && kernels.precision == Precision::Float) {
                 constexpr int G = kKdGroupPackets;
-                trace_in_groups<K, G, AnyHit>(
+                trace_in_groups_or_alone<K, G, AnyHit>(
                     rays, hits, kernels.rcp, [](const LoadedPacket<K>& p) { return may_lead_group<K>(p); }, trace_one,
-                    [&](LoadedPacket<K>* p, int count) {
-                        if (count > 1 && trace_group<K, G, AnyHit>(tree, isect, p, count)) return;
-                        for (int q = 0; q < count; ++q) trace_one(p[q].ray, p[q].hit, p[q].valid, p[q].occluded);
-                    });
+                    [&](LoadedPacket<K>* p, int count) { return trace_group<K, G, AnyHit>(tree, isect, p, count); });
                 return;
             }
         }

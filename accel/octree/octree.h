@@ -26,6 +26,9 @@ struct OctreeConfig {
     /// Place triangles by exact triangle-box overlap and spheres by their
     /// distance to the box; false places every primitive by its box only.
     bool exact_overlap = true;
+    /// Packets of one direction octant walk the tree in groups
+    /// (octree_packet.cpp, trace_group); false: each packet alone.
+    bool packet_groups = true;
 };
 
 /// 8 bytes. Inner: `first` is the index of child 0, the eight children follow

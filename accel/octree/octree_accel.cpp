@@ -14,7 +14,7 @@
 namespace raypack {
 
 OctreeAccel::OctreeAccel(const Scene& scene, const AccelConfig& config, const OctreeConfig& octree_config)
-    : scene_(&scene), kernels_(config.kernels) {
+    : scene_(&scene), kernels_(config.kernels), packet_groups_(octree_config.packet_groups) {
     const std::size_t n = scene.primitive_count();
     std::vector<Box3f> boxes(n);
     tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) { boxes[i] = primitive_bounds(scene, std::uint32_t(i)); });
@@ -82,6 +82,7 @@ bool OctreeAccel::walk(Rayf& ray, Hitf& hit, OctreeRayCounters* counters) const 
     if (!(std::max(enter, ray.tnear) <= std::min(exit, ray.tfar))) return false;
 
     const PrimitiveIntersector<float> isect{scene_, kernels_};
+    const bool float_ties = kernels_.precision == Precision::Float;
     const OctreeNode* nodes = tree_.nodes.data();
     const std::uint32_t* refs = tree_.refs.data();
     bool found = false;
@@ -90,9 +91,16 @@ bool OctreeAccel::walk(Rayf& ray, Hitf& hit, OctreeRayCounters* counters) const 
         if constexpr (Counting) ++counters->leaves_visited;
         for (std::uint32_t k = leaf.first; k < leaf.first + leaf.count; ++k) {
             if constexpr (Counting) ++counters->prim_tests;
+            const Hitf before = hit;
             if (isect.intersect(refs[k], ray, hit)) {
                 found = true;
                 if constexpr (AnyHit) return true;
+                // Equal t: the lowest primitive number wins (accel/packet_ties.h),
+                // so that groups of packets, which test more leaves than a
+                // lane's own walk, keep the single ray's hit. (Double tests
+                // go lane by lane in the packets' own order, and never in
+                // groups: the last one tested wins, as in single rays.)
+                if (float_ties && hit.t == before.t && before.prim < refs[k]) hit = before;
             }
         }
         return false;
@@ -150,7 +158,7 @@ bool OctreeAccel::walk(Rayf& ray, Hitf& hit, OctreeRayCounters* counters) const 
 template <bool AnyHit>
 void OctreeAccel::trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
     with_packet_width(width, "octree", [&]<int K>() {
-        octree_trace_packets<K, AnyHit>(tree_, *scene_, kernels_, rays, hits);
+        octree_trace_packets<K, AnyHit>(tree_, *scene_, kernels_, rays, hits, packet_groups_);
     });
 }
 

@@ -46,6 +46,7 @@ private:
     KernelChoice kernels_;
     Octree tree_;
     std::size_t empty_leaves_ = 0;
+    bool packet_groups_;
 };
 
 extern template class CellAccel<OctreeAccel, OctreeRayCounters>;  // octree_accel.cpp

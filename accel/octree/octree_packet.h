@@ -13,11 +13,17 @@
 
 namespace raypack {
 
+/// Packets that walk the tree as one group when their rays share a direction
+/// octant (octree_packet.cpp, trace_group).
+inline constexpr int kOctreeGroupPackets = 8;
+
 /// Closest hits (AnyHit = false) or occlusion (AnyHit = true, hits[i].prim
-/// = 0 where occluded) of `rays` in packets of K. Defined for the K that are
-/// compiled in (see kWidthCompiled).
+/// = 0 where occluded) of `rays` in packets of K; with `groups`, packets
+/// whose rays share a direction octant walk the tree kOctreeGroupPackets at a time
+/// (octree_packet.cpp, trace_group), with the same answers. Defined for the
+/// K that are compiled in (see kWidthCompiled).
 template <int K, bool AnyHit>
 void octree_trace_packets(const Octree& tree, const Scene& scene, KernelChoice kernels, std::span<const Rayf> rays,
-                          std::span<Hitf> hits);
+                          std::span<Hitf> hits, bool groups = true);
 
 }  // namespace raypack
