@@ -107,11 +107,11 @@ int run_trace(const Args& args) {
         j["builder"] = as.builder;
         j["packet"] = packet;
         // Packets per shared walk, at most (1: alone). The k-d tree groups
-        // rays from one point in float precision, the octree rays of one
-        // octant; both keep the rest alone.
+        // rays from one point (robust slabs), the octree rays of one octant,
+        // both in float precision; both keep the rest alone.
         const bool wide = (as.name == "bvh4" || as.name == "bvh8") && packet > 1;
-        const bool cells = (as.name == "kdtree" || as.name == "octree") && packet > 1 && config.packet_group != 1 &&
-                           config.kernels.precision == Precision::Float;
+        const bool cells = (as.name == "octree" || (as.name == "kdtree" && config.kernels.slabs == SlabMethod::Robust)) &&
+                           packet > 1 && config.packet_group != 1 && config.kernels.precision == Precision::Float;
         j["group"] = wide    ? (config.packet_group > 0 ? config.packet_group
                                                         : default_wide_packet_config(4, packet).group_packets)
                      : cells ? (as.name == "kdtree" ? kKdGroupPackets : kOctreeGroupPackets)

@@ -4,6 +4,7 @@
 // place, where std::vector's push_back checks its capacity and moves its end
 // at every entry (three vectors per shadow ray) and resize would write every
 // entry twice.
+#include <cassert>
 #include <cstddef>
 #include <cstring>
 #include <memory>
@@ -30,6 +31,7 @@ public:
     }
     /// append() within room reserve() made: no capacity check.
     T* append_reserved(std::size_t n) {
+        assert(size_ + n <= capacity_);
         T* p = data_.get() + size_;
         size_ += n;
         return p;

@@ -73,7 +73,9 @@ struct Paths {
         std::fill_n(count_emission.resize_for_overwrite(n), n, std::uint8_t(1));
         std::fill_n(bounce_pdf.resize_for_overwrite(n), n, 0.0f);
     }
-    /// Room for n more paths, for append_reserved().
+    /// Room for n more paths, for append_reserved(). The arrays always have
+    /// the same capacity (they grow together, here and in
+    /// start_camera_paths), so rays' stands for all.
     void reserve_more(std::size_t n) {
         const std::size_t need = rays.size() + n;
         if (need <= rays.capacity()) [[likely]]
@@ -125,7 +127,8 @@ struct Shadows {
         sample.clear();
         contribution.clear();
     }
-    /// Room for n more shadow rays, for append_reserved().
+    /// Room for n more shadow rays, for append_reserved() (the arrays grow
+    /// together, as Paths').
     void reserve_more(std::size_t n) {
         const std::size_t need = rays.size() + n;
         if (need <= rays.capacity()) [[likely]]

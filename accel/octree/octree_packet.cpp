@@ -254,15 +254,15 @@ RAYPACK_INLINE int packet_octant(const LoadedPacket<K>& p) {
 // the bounds bound every lane's own (PacketFrame's arithmetic, operation for
 // operation). A packet enters a child when its bounds allow one of its
 // lanes to (max of the lower entries <= min of the upper exits, within its
-// lanes' [tnear, tfar]): every leaf a lane's own walk reaches, and a few
-// more. All of the packet's live lanes test the leaf's primitives, so each
-// lane tests at least the primitives its single ray does and, under the tie
-// rule, keeps the same closest hit. A packet reaching a leaf clips its
-// lanes to the leaf's box, widened by twice the placement margin (which
+// lanes' [tnear, tfar]): every leaf a lane's own walk reaches, and more.
+// A packet reaching a leaf (or a small inner node, kClipBelow) clips its
+// lanes to the node's box, widened by twice the placement margin (which
 // covers the rounding of a lane's own parameters, octree_build.cpp), and
-// only those test it. Children are taken in ascending mirrored order, front
-// to back for every lane of every packet. Returns false, tracing nothing,
-// if the packets do not share one octant.
+// the lanes left test the leaf's primitives: each lane tests at least the
+// primitives its single ray does and, under the tie rule, keeps the same
+// closest hit. Children are taken in ascending mirrored order, front to
+// back for every lane of every packet. Returns false, tracing nothing, if
+// the packets do not share one octant.
 template <int K, bool AnyHit, SlabMethod Slabs>
 bool trace_group(const Octree& tree, const PacketPrimitiveIntersector<vfloat<K>>& isect, LoadedPacket<K>* p,
                  int count) {

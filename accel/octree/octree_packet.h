@@ -2,7 +2,9 @@
 // Packet traversal of the octree: the lanes of a packet whose directions lie
 // in one octant walk the tree together in one shared front-to-back order,
 // each inner node's children tested with the parametric intervals of
-// Revelles et al. (lane-wise), leaves tested for the lanes that reach them.
+// Revelles et al. (lane-wise), leaves tested for the lanes that reach them;
+// and groups of such packets in one walk, each standing for its lanes by
+// bounds of their parameters.
 #include <cstdint>
 #include <span>
 
