@@ -80,4 +80,24 @@ private:
     }
 };
 
+/// Room for `need` entries in each of `buffers`, arrays that always grow
+/// together (one entry each per item): the first's capacity stands for all.
+template <class First, class... Rest>
+void reserve_together(std::size_t need, First& first, Rest&... rest) {
+    if (need <= first.capacity()) [[likely]]
+        return;
+    first.reserve(need);
+    (rest.reserve(need), ...);
+}
+
+/// One more entry in each of `buffers`, within reserve_together()'s room;
+/// returns its index.
+template <class First, class... Rest>
+inline std::size_t append_together(First& first, Rest&... rest) {
+    const std::size_t k = first.size();
+    first.append_reserved(1);
+    (rest.append_reserved(1), ...);
+    return k;
+}
+
 }  // namespace raypack

@@ -73,35 +73,17 @@ struct Paths {
         std::fill_n(count_emission.resize_for_overwrite(n), n, std::uint8_t(1));
         std::fill_n(bounce_pdf.resize_for_overwrite(n), n, 0.0f);
     }
-    /// Room for n more paths, for append_reserved(). The arrays always have
-    /// the same capacity (they grow together, here and in
-    /// start_camera_paths), so rays' stands for all.
+    /// Room for n more paths, for append_reserved() (the arrays grow
+    /// together, here and in start_camera_paths).
     void reserve_more(std::size_t n) {
-        const std::size_t need = rays.size() + n;
-        if (need <= rays.capacity()) [[likely]]
-            return;
-        rays.reserve(need);
-        hits.reserve(need);
-        throughput.reserve(need);
-        sample.reserve(need);
-        count_emission.reserve(need);
-        bounce_pdf.reserve(need);
-        bounce_origin.reserve(need);
+        reserve_together(rays.size() + n, rays, hits, throughput, sample, count_emission, bounce_pdf, bounce_origin);
     }
     /// One more path within reserve_more()'s room, every entry but its hit
     /// left for the caller to write (a Rayf built on the stack and copied
     /// stalls on store forwarding: 13% of a path-traced Cornell box);
     /// returns its index.
     RAYPACK_INLINE std::size_t append_reserved() {
-        const std::size_t k = rays.size();
-        rays.append_reserved(1);
-        hits.append_reserved(1);
-        throughput.append_reserved(1);
-        sample.append_reserved(1);
-        count_emission.append_reserved(1);
-        bounce_pdf.append_reserved(1);
-        bounce_origin.append_reserved(1);
-        return k;
+        return append_together(rays, hits, throughput, sample, count_emission, bounce_pdf, bounce_origin);
     }
     /// A new path whose ray the caller writes in place. `origin`: where a
     /// diffuse bounce left (read only when pdf > 0).
@@ -127,25 +109,11 @@ struct Shadows {
         sample.clear();
         contribution.clear();
     }
-    /// Room for n more shadow rays, for append_reserved() (the arrays grow
-    /// together, as Paths').
-    void reserve_more(std::size_t n) {
-        const std::size_t need = rays.size() + n;
-        if (need <= rays.capacity()) [[likely]]
-            return;
-        rays.reserve(need);
-        sample.reserve(need);
-        contribution.reserve(need);
-    }
+    /// Room for n more shadow rays, for append_reserved().
+    void reserve_more(std::size_t n) { reserve_together(rays.size() + n, rays, sample, contribution); }
     /// One more shadow ray within reserve_more()'s room, for the caller to
     /// write; returns its index.
-    RAYPACK_INLINE std::size_t append_reserved() {
-        const std::size_t k = rays.size();
-        rays.append_reserved(1);
-        sample.append_reserved(1);
-        contribution.append_reserved(1);
-        return k;
-    }
+    RAYPACK_INLINE std::size_t append_reserved() { return append_together(rays, sample, contribution); }
 };
 
 /// A camera sample: its pixel (with the pixel's part of the sampler's hash,
