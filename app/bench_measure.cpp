@@ -17,7 +17,8 @@
 namespace raypack::app {
 namespace {
 
-constexpr std::size_t kBatch = 256;       // rays per call into the structure in the timed loop
+constexpr std::size_t kBatch = 256;        // rays per validation and counting block
+constexpr std::size_t kTimedBatch = 4096;  // rays per call into the structure in the timed loop (cmd_trace.cpp)
 constexpr std::size_t kSampleBlock = 64;  // consecutive rays per sample block (a multiple of every packet width)
 
 /// Positions of up to `max_rays` rays of `n`, in blocks of `block` spread evenly.
@@ -43,9 +44,9 @@ std::vector<Rayf> gather(const std::vector<Rayf>& rays, const std::vector<std::s
 /// Any-hit answers stored as hits: prim 0 marks an occluded ray (docs/rays.md).
 void trace_block(const Accel& accel, int packet, bool any_hit, std::span<const Rayf> rays, std::span<Hitf> hits) {
     if (!any_hit) return accel.intersect_packets(packet, rays, hits);
-    std::uint8_t occluded[kBatch];
-    for (std::size_t lo = 0; lo < rays.size(); lo += kBatch) {
-        const std::size_t n = std::min(kBatch, rays.size() - lo);
+    std::uint8_t occluded[kTimedBatch];
+    for (std::size_t lo = 0; lo < rays.size(); lo += kTimedBatch) {
+        const std::size_t n = std::min(kTimedBatch, rays.size() - lo);
         accel.occluded_packets(packet, rays.subspan(lo, n), std::span<std::uint8_t>(occluded, n));
         for (std::size_t i = 0; i < n; ++i) {
             hits[lo + i] = Hitf{};
@@ -149,7 +150,7 @@ std::vector<double> time_passes(const Accel& accel, int packet, const BenchRays&
     std::vector<double> ms;
     for (int pass = -1; pass < repeat; ++pass) {  // pass -1: the warm-up
         const auto start = std::chrono::steady_clock::now();
-        trace_all(accel, packet, set.any_hit, set.rays, hits, kBatch);
+        trace_all(accel, packet, set.any_hit, set.rays, hits, kTimedBatch);
         const auto stop = std::chrono::steady_clock::now();
         if (pass >= 0) ms.push_back(std::chrono::duration<double, std::milli>(stop - start).count());
     }
