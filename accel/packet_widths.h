@@ -37,8 +37,8 @@ void with_packet_width(int width, const std::string& who, Fn&& fn) {
 /// occluded[i] from `trace(rays, hits)`, a packet loop whose any-hit answers
 /// come as hits (found() = occluded: accel/packet_driver.h), in slices of
 /// 2,048 rays through a buffer on the stack (no allocation per call; 32 KB).
-/// A slice holds 8 of the BVHs' groups of 256 rays, so that each group's
-/// walk can ask for the next group's rays (trace_in_groups).
+/// A slice holds 8 of trace_in_groups' loads of 16 packets, so that each
+/// load's walk can ask for the next load's rays (accel/packet_driver.h).
 template <class TraceAnyHit>
 void occlusion_in_slices(std::span<const Rayf> rays, std::span<std::uint8_t> occluded, TraceAnyHit&& trace) {
     constexpr std::size_t kSlice = 2048;

@@ -21,8 +21,9 @@
 namespace raypack::app {
 namespace {
 
-// Rays per call into the structure: 16 of the BVHs' groups of 256 rays, so
-// that a group's walk can ask for the next group's rays (packet_driver.h).
+// Rays per call into the structure: 16 of the packet loop's loads of 256
+// rays, so that each load's walk can ask for the next one's rays
+// (trace_in_groups, accel/packet_driver.h).
 constexpr std::size_t kBatch = 4096;
 
 /// One pass over all rays, batches in parallel; returns milliseconds.
