@@ -11,6 +11,7 @@
 
 #include "accel/accel.h"
 #include "accel/cell_kernel_variants.h"
+#include "accel/prims/triangle_edges.h"
 
 namespace raypack {
 
@@ -34,10 +35,27 @@ public:
                          TraversalCounts& counts) const override;
 
     bool supports_packet(int width) const override;
+
+    /// Memory of the triangle records (make_triangle_edges), part of stats().bytes.
+    std::size_t triangle_edge_bytes() const { return triangle_edges_.bytes(); }
     void intersect_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const override;
     void occluded_packets(int width, std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override;
 
+protected:
+    /// Moeller's records of the scene's triangles for the leaves' tests
+    /// (accel/prims/triangle_edges.h), when `kernels` test triangles by
+    /// Moeller-Trumbore in float (the default): made by each structure's
+    /// constructor, counted in its build time and memory. Other kernels
+    /// read the vertices.
+    void make_triangle_edges(const Scene& scene, const KernelChoice& kernels) {
+        if (kernels.triangle == TriangleMethod::Moeller && kernels.precision == Precision::Float)
+            triangle_edges_ = TriangleEdgeTable(scene);
+    }
+    const TriangleEdgeRecord* triangle_edges() const { return triangle_edges_.data(); }
+
 private:
+    TriangleEdgeTable triangle_edges_;
+
     const Derived& self() const { return static_cast<const Derived&>(*this); }
     template <bool AnyHit>
     bool counting_walk(Rayf& ray, Hitf& hit, Counters& counters) const;

@@ -7,6 +7,7 @@
 
 #include "accel/kernel_choice.h"
 #include "accel/prims/prim_kinds.h"
+#include "accel/prims/triangle_edges.h"
 #include "scene/scene.h"
 
 namespace raypack {
@@ -15,6 +16,9 @@ template <class T>
 struct PrimitiveIntersector {
     const Scene* scene;
     KernelChoice kernels;
+    /// Moeller's records of the scene's triangles (TriangleEdgeTable; float
+    /// only), or null: triangles are then tested from their vertices.
+    const TriangleEdgeRecord* triangle_edges = nullptr;
 
     /// If primitive `prim` is hit within [ray.tnear, ray.tfar], records it in
     /// `hit`, shrinks ray.tfar to the hit and returns true.
@@ -25,6 +29,15 @@ struct PrimitiveIntersector {
         T t{}, u{}, v{};
         std::uint32_t id = prim;
         const bool found = PrimKinds::dispatch(ref.kind, [&]<class Kind>() RAYPACK_INLINE_LAMBDA {
+            if constexpr (std::is_same_v<T, float> && std::is_same_v<Kind, TrianglePrims>)
+                if (triangle_edges) {
+                    T tt, uu, vv;
+                    if (!intersect_triangle_record<T>(triangle_edges[ref.index], true, ray.org, ray.dir, ray.tnear,
+                                                      ray.tfar, tt, uu, vv))
+                        return false;
+                    t = tt, u = uu, v = vv;
+                    return true;
+                }
             if constexpr (names_hits<Kind>) return Kind::intersect(*scene, ref.index, kernels, ray, t, u, v, id);
             else return Kind::intersect(*scene, ref.index, kernels, ray, t, u, v);
         });

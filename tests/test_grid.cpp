@@ -84,7 +84,7 @@ TEST_P(Grid, MatchesBruteForce) {
     EXPECT_EQ(s.leaves, nonempty);
     EXPECT_DOUBLE_EQ(grid.empty_cell_fraction(), 1.0 - double(nonempty) / double(grid.cell_count()));
     EXPECT_EQ(s.bytes, (grid.cell_count() + 1 + grid.reference_count()) * sizeof(std::uint32_t) +
-                           grid.grid().macro.full.size());
+                           grid.grid().macro.full.size() + grid.triangle_edge_bytes());
     EXPECT_GE(grid.references_per_primitive(), 1.0);
     const double cells_per_prim = double(grid.cell_count()) / double(scene.primitive_count());
     const double lambda = GridConfig{}.lambda;
@@ -670,7 +670,7 @@ int expect_coherent_walk_matches(const GridAccel& grid, const Scene& scene, cons
     using F = vfloat<K>;
     const BruteForce brute(scene, KernelChoice{});
     const std::vector<Hitf> truth = trace(brute, rays);
-    const PacketPrimitiveIntersector<F> isect{&scene, KernelChoice{}};
+    const PacketRecordIntersector<F> isect{&scene, KernelChoice{}};
     const GridGeometry& g = grid.grid().geometry;
     std::vector<Hitf> got(rays.size());
     std::vector<std::uint8_t> occluded(rays.size()), want_occluded(rays.size());

@@ -155,7 +155,7 @@ void expect_well_formed(const OctreeAccel& accel, const Scene& scene, const Octr
     EXPECT_EQ(s.leaves, leaves);
     EXPECT_EQ(s.depth, depth);
     EXPECT_EQ(accel.empty_leaves(), empty);
-    EXPECT_EQ(s.bytes, t.nodes.size() * 8 + t.refs.size() * 4);
+    EXPECT_EQ(s.bytes, t.nodes.size() * 8 + t.refs.size() * 4 + accel.triangle_edge_bytes());
     EXPECT_GE(s.build_ms, 0.0);
     if (scene.primitive_count()) {
         EXPECT_GE(accel.references_per_primitive(), 1.0);

@@ -24,6 +24,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "accel/prims/triangle_edges.h"
 #include "kernels/triangle.h"
 
 namespace raypack {
@@ -458,6 +459,53 @@ TYPED_TEST(PacketTriangle, MoellerDeferredUVEqualsImmediate) {
     packet_chunk(0, c);
     EXPECT_TRUE(deferred_matches_immediate<K>(c)) << "random rays";
     EXPECT_TRUE(deferred_matches_immediate<K>(adversarial_cases(77))) << "adversarial rays";
+}
+
+/// Moeller's test on a triangle's record (accel/prims/triangle_edges.h: the
+/// edges and normal computed once, read by the octree's and the grids'
+/// leaves) gives the test on its vertices bit for bit: K rays against the
+/// record of their packet's first triangle, against width 1 on the vertices.
+template <int K>
+::testing::AssertionResult record_matches_vertices(const Cases& c) {
+    using F = vfloat<K>;
+    std::size_t bad = 0, hits = 0;
+    std::string first;
+    for (std::size_t i = 0; i + K <= c.size(); i += K) {
+        const Tri tri = c.tri(i);
+        const auto e = triangle_detail::moeller_edges(tri.p0, tri.p1, tri.p2);
+        const TriangleEdgeRecord record{tri.p0, e.e1n, e.e2, e.ng};
+        auto L = [&](int field) { return load_lanes<F>(&c.f[field][i]); };
+        const Vec3<F> o{L(Cases::OX), L(Cases::OY), L(Cases::OZ)}, d{L(Cases::DX), L(Cases::DY), L(Cases::DZ)};
+        F t = F(0.0f), u = F(0.0f), v = F(0.0f);
+        const std::uint32_t bits = mask_bits(
+            intersect_triangle_record<F>(record, mask_of<F>(true), o, d, L(Cases::TN), L(Cases::TF), t, u, v));
+        for (int l = 0; l < K; ++l) {
+            const TestRay r = c.ray(i + std::size_t(l));
+            float t1 = 0, u1 = 0, v1 = 0;
+            const bool want = intersect_triangle_moeller<float>(true, r.org, r.dir, r.tnear, r.tfar, tri.p0, tri.p1,
+                                                                tri.p2, t1, u1, v1);
+            const bool got = (bits >> l) & 1u;
+            hits += want;
+            if (want == got && (!want || (same_bits(t1, lane(t, l)) && same_bits(u1, lane(u, l)) &&
+                                          same_bits(v1, lane(v, l)))))
+                continue;
+            if (++bad == 1) first = "\n  " + str(r, tri);
+        }
+    }
+    if (bad == 0 && hits > 0) return ::testing::AssertionSuccess();
+    return ::testing::AssertionFailure() << bad << " of " << c.size() << " lanes differ (" << hits << " hits)"
+                                         << first;
+}
+
+TYPED_TEST(PacketTriangle, MoellerRecordEqualsVertices) {
+    constexpr int K = TypeParam::value;
+    Cases c;
+    for (std::size_t k = 0; k < 4; ++k) {
+        packet_chunk(k, c);
+        ASSERT_TRUE(record_matches_vertices<K>(c)) << "random rays, chunk " << k;
+    }
+    EXPECT_TRUE(record_matches_vertices<K>(adversarial_cases(77))) << "adversarial rays";
+    if constexpr (K > 1) EXPECT_TRUE(record_matches_vertices<1>(adversarial_cases(78))) << "width 1";
 }
 
 /// A NaN anywhere in the Moeller test, or products that overflow, make a

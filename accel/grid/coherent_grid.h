@@ -203,7 +203,7 @@ bool walk(const Grid& grid, int k, const RayPacket<K>& ray, vmask<K>& active, vf
 /// primitive once per packet (a direct-mapped mailbox). AnyHit: lanes that
 /// hit are added to `occluded` and stop.
 template <int K, bool AnyHit>
-bool trace(const Grid& grid, const PacketPrimitiveIntersector<vfloat<K>>& isect, int k, RayPacket<K>& ray,
+bool trace(const Grid& grid, const PacketRecordIntersector<vfloat<K>>& isect, int k, RayPacket<K>& ray,
            HitPacket<K>& hit, vmask<K>& active, vfloat<K>& entry, vmask<K>& occluded) {
     constexpr std::uint32_t kMailboxSize = 128;
     alignas(64) std::uint32_t mailbox[kMailboxSize];

@@ -36,7 +36,8 @@ Grid2Accel::Grid2Accel(const Scene& scene, const AccelConfig& config, const TwoL
     stats_.nodes = grid_.top.geometry.cells() + cells;
     stats_.leaves = cells - empty;
     stats_.empty_leaves = empty + top_empty;
-    stats_.bytes = grid_.bytes();
+    make_triangle_edges(scene, kernels_);
+    stats_.bytes = grid_.bytes() + triangle_edge_bytes();
     stats_.depth = 2;
     stats_.refs_per_prim = n ? double(references) / double(n) : 0.0;
 }
@@ -74,7 +75,7 @@ bool Grid2Accel::walk(Rayf& ray, Hitf& hit, GridRayCounters* counters) const {
     const SlabRay<float> slab = make_slab_ray(ray.org, inv_dir, ray.tnear, ray.tfar);
     const Grid& top = grid_.top;
     if (!intersect_box<Slabs, float>(true, slab, top.geometry.bounds.lo, top.geometry.bounds.hi, entry)) return false;
-    const PrimitiveIntersector<float> isect{scene_, kernels_};
+    const PrimitiveIntersector<float> isect{scene_, kernels_, triangle_edges()};
     Mailbox mailbox;
     GridDda top_dda(top.geometry, ray.org, ray.dir, inv_dir, entry, SlabTag<Slabs>{});
     bool found = false;
@@ -126,7 +127,7 @@ bool Grid2Accel::walk(Rayf& ray, Hitf& hit, GridRayCounters* counters) const {
 // own DDA). Lanes the top walk gives up on, and packets that are not
 // coherent, finish one ray at a time from where they are.
 template <int K, bool AnyHit, SlabMethod Slabs>
-void Grid2Accel::trace_packet(const PacketPrimitiveIntersector<vfloat<K>>& isect, RayPacket<K>& ray,
+void Grid2Accel::trace_packet(const PacketRecordIntersector<vfloat<K>>& isect, RayPacket<K>& ray,
                               HitPacket<K>& hit, vmask<K> valid, vmask<K>& occluded) const {
     using F = vfloat<K>;
     F entry;
@@ -198,7 +199,7 @@ void Grid2Accel::trace_packet(const PacketPrimitiveIntersector<vfloat<K>>& isect
 template <bool AnyHit>
 void Grid2Accel::trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
     with_packet_width(width, "grid2", [&]<int K>() {
-        const PacketPrimitiveIntersector<vfloat<K>> isect{scene_, kernels_};
+        const PacketRecordIntersector<vfloat<K>> isect{scene_, kernels_, triangle_edges()};
         with_slab_form(kernels_.slabs, [&]<SlabMethod Slabs>(SlabTag<Slabs>) {
             trace_in_packets<K, AnyHit>(rays, hits, kernels_.rcp,
                                         [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid, vmask<K>& occluded) {

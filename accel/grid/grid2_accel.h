@@ -23,7 +23,7 @@ private:
     template <bool AnyHit>
     void trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const;
     template <int K, bool AnyHit, SlabMethod Slabs>
-    void trace_packet(const PacketPrimitiveIntersector<vfloat<K>>& isect, RayPacket<K>& ray, HitPacket<K>& hit,
+    void trace_packet(const PacketRecordIntersector<vfloat<K>>& isect, RayPacket<K>& ray, HitPacket<K>& hit,
                       vmask<K> valid, vmask<K>& occluded) const;
     template <bool AnyHit, bool Counting, SlabMethod Slabs>
     bool walk(Rayf& ray, Hitf& hit, GridRayCounters* counters) const;

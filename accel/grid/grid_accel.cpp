@@ -30,7 +30,8 @@ GridAccel::GridAccel(const Scene& scene, const AccelConfig& config, const GridCo
     stats_.builder = "uniform";
     stats_.nodes = grid_.geometry.cells();
     stats_.leaves = grid_.geometry.cells() - empty_cells_;
-    stats_.bytes = grid_.bytes();
+    make_triangle_edges(scene, kernels_);
+    stats_.bytes = grid_.bytes() + triangle_edge_bytes();
     stats_.depth = 1;
     stats_.refs_per_prim = references_per_primitive();
     stats_.empty_leaves = empty_cells_;
@@ -63,7 +64,7 @@ bool GridAccel::trace(Rayf& ray, Hitf& hit, GridRayCounters* counters) const {
     const SlabRay<float> slab = make_slab_ray(ray.org, inv_dir, ray.tnear, ray.tfar);
     if (!intersect_box<Slabs, float>(true, slab, grid_.geometry.bounds.lo, grid_.geometry.bounds.hi, entry))
         return false;
-    const PrimitiveIntersector<float> isect{scene_, kernels_};
+    const PrimitiveIntersector<float> isect{scene_, kernels_, triangle_edges()};
     const std::uint32_t* begin = grid_.cell_begin.data();
     const std::uint32_t* refs = grid_.refs.data();
     // Direct-mapped on the primitive number: a collision only costs a re-test.
@@ -112,7 +113,7 @@ bool GridAccel::trace(Rayf& ray, Hitf& hit, GridRayCounters* counters) const {
 template <bool AnyHit>
 void GridAccel::trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
     with_packet_width(width, "grid", [&]<int K>() {
-        grid_trace_packets<K, AnyHit>(grid_, *scene_, kernels_, coherent_packets_, rays, hits);
+        grid_trace_packets<K, AnyHit>(grid_, *scene_, kernels_, triangle_edges(), coherent_packets_, rays, hits);
     });
 }
 

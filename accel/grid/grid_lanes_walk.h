@@ -22,7 +22,7 @@ namespace raypack::grid_lanes {
 // boundary (or, for occlusion, at its first hit). `entry`: where each lane
 // starts, inside the grid's box.
 template <int K, bool AnyHit, SlabMethod Slabs>
-void dda_walk(const Grid& grid, const PacketPrimitiveIntersector<vfloat<K>>& isect, RayPacket<K>& ray,
+void dda_walk(const Grid& grid, const PacketRecordIntersector<vfloat<K>>& isect, RayPacket<K>& ray,
               HitPacket<K>& hit, vmask<K> active, const vfloat<K>& entry, vmask<K>& occluded) {
     using M = vmask<K>;
     GridDdaPacket<K, Slabs> dda(grid.geometry, ray, entry);

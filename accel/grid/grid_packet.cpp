@@ -20,10 +20,11 @@ bool grid_packets_exact(const Grid& grid) {
 }
 
 template <int K, bool AnyHit>
-void grid_trace_packets(const Grid& grid, const Scene& scene, KernelChoice kernels, bool coherent,
+void grid_trace_packets(const Grid& grid, const Scene& scene, KernelChoice kernels,
+                        const TriangleEdgeRecord* triangle_edges, bool coherent,
                         std::span<const Rayf> rays, std::span<Hitf> hits) {
     using F = vfloat<K>;
-    const PacketPrimitiveIntersector<F> isect{&scene, kernels};
+    const PacketRecordIntersector<F> isect{&scene, kernels, triangle_edges};
     // The slab form is chosen once for all packets, rdir once per packet.
     with_slab_form(kernels.slabs, [&]<SlabMethod Slabs>(SlabTag<Slabs>) {
         trace_in_packets<K, AnyHit>(rays, hits, kernels.rcp, [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid,
@@ -45,21 +46,21 @@ void grid_trace_packets(const Grid& grid, const Scene& scene, KernelChoice kerne
 }
 
 #if defined(__SSE4_2__)
-template void grid_trace_packets<4, false>(const Grid&, const Scene&, KernelChoice, bool, std::span<const Rayf>,
+template void grid_trace_packets<4, false>(const Grid&, const Scene&, KernelChoice, const TriangleEdgeRecord*, bool, std::span<const Rayf>,
                                               std::span<Hitf>);
-template void grid_trace_packets<4, true>(const Grid&, const Scene&, KernelChoice, bool, std::span<const Rayf>,
+template void grid_trace_packets<4, true>(const Grid&, const Scene&, KernelChoice, const TriangleEdgeRecord*, bool, std::span<const Rayf>,
                                               std::span<Hitf>);
 #endif
 #if defined(__AVX2__)
-template void grid_trace_packets<8, false>(const Grid&, const Scene&, KernelChoice, bool, std::span<const Rayf>,
+template void grid_trace_packets<8, false>(const Grid&, const Scene&, KernelChoice, const TriangleEdgeRecord*, bool, std::span<const Rayf>,
                                               std::span<Hitf>);
-template void grid_trace_packets<8, true>(const Grid&, const Scene&, KernelChoice, bool, std::span<const Rayf>,
+template void grid_trace_packets<8, true>(const Grid&, const Scene&, KernelChoice, const TriangleEdgeRecord*, bool, std::span<const Rayf>,
                                               std::span<Hitf>);
 #endif
 #if defined(__AVX512BW__)
-template void grid_trace_packets<16, false>(const Grid&, const Scene&, KernelChoice, bool, std::span<const Rayf>,
+template void grid_trace_packets<16, false>(const Grid&, const Scene&, KernelChoice, const TriangleEdgeRecord*, bool, std::span<const Rayf>,
                                               std::span<Hitf>);
-template void grid_trace_packets<16, true>(const Grid&, const Scene&, KernelChoice, bool, std::span<const Rayf>,
+template void grid_trace_packets<16, true>(const Grid&, const Scene&, KernelChoice, const TriangleEdgeRecord*, bool, std::span<const Rayf>,
                                               std::span<Hitf>);
 #endif
 

@@ -26,7 +26,8 @@ bool grid_packets_exact(const Grid& grid);
 /// same answers as the single-ray walk without mailbox, bit for bit.
 /// Defined for the K that are compiled in (see kWidthCompiled).
 template <int K, bool AnyHit>
-void grid_trace_packets(const Grid& grid, const Scene& scene, KernelChoice kernels, bool coherent,
+void grid_trace_packets(const Grid& grid, const Scene& scene, KernelChoice kernels,
+                        const TriangleEdgeRecord* triangle_edges, bool coherent,
                         std::span<const Rayf> rays, std::span<Hitf> hits);
 
 }  // namespace raypack

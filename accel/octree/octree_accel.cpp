@@ -29,7 +29,8 @@ OctreeAccel::OctreeAccel(const Scene& scene, const AccelConfig& config, const Oc
     stats_.builder = "adaptive";
     stats_.nodes = tree_.nodes.size();
     stats_.leaves = leaves;
-    stats_.bytes = tree_.bytes();
+    make_triangle_edges(scene, kernels_);
+    stats_.bytes = tree_.bytes() + triangle_edge_bytes();
     stats_.depth = tree_.depth;
     stats_.refs_per_prim = references_per_primitive();
     stats_.empty_leaves = empty_leaves_;
@@ -81,7 +82,7 @@ bool OctreeAccel::walk(Rayf& ray, Hitf& hit, OctreeRayCounters* counters) const 
     const float enter = std::max({f.t0[0], f.t0[1], f.t0[2]}), exit = std::min({f.t1[0], f.t1[1], f.t1[2]});
     if (!(std::max(enter, ray.tnear) <= std::min(exit, ray.tfar))) return false;
 
-    const PrimitiveIntersector<float> isect{scene_, kernels_};
+    const PrimitiveIntersector<float> isect{scene_, kernels_, triangle_edges()};
     const bool float_ties = kernels_.precision == Precision::Float;
     const OctreeNode* nodes = tree_.nodes.data();
     const std::uint32_t* refs = tree_.refs.data();
@@ -158,7 +159,7 @@ bool OctreeAccel::walk(Rayf& ray, Hitf& hit, OctreeRayCounters* counters) const 
 template <bool AnyHit>
 void OctreeAccel::trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
     with_packet_width(width, "octree", [&]<int K>() {
-        octree_trace_packets<K, AnyHit>(tree_, *scene_, kernels_, rays, hits, packet_groups_);
+        octree_trace_packets<K, AnyHit>(tree_, *scene_, kernels_, triangle_edges(), rays, hits, packet_groups_);
     });
 }
 

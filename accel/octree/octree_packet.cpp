@@ -70,7 +70,7 @@ RAYPACK_INLINE std::uint32_t mirrored_children(std::uint32_t bits, unsigned a) {
 /// closest hits under the tie rule (accel/packet_ties.h), or occlusion
 /// added to `occluded`. The leaf step of both walks below.
 template <int K, bool AnyHit>
-RAYPACK_INLINE void test_refs(const PacketPrimitiveIntersector<vfloat<K>>& isect, const std::uint32_t* refs,
+RAYPACK_INLINE void test_refs(const PacketRecordIntersector<vfloat<K>>& isect, const std::uint32_t* refs,
                               std::uint32_t count, vmask<K> m, RayPacket<K>& ray, HitPacket<K>& hit,
                               vmask<K>& occluded) {
     for (std::uint32_t k = 0; k < count; ++k) {
@@ -94,7 +94,7 @@ RAYPACK_INLINE void test_refs(const PacketPrimitiveIntersector<vfloat<K>>& isect
 // Revelles et al. visits; tfar shrinks with each hit, so a lane drops out of
 // every node behind its closest hit (early termination per lane).
 template <int K, bool AnyHit, SlabMethod Slabs>
-void walk(const Octree& tree, const PacketPrimitiveIntersector<vfloat<K>>& isect, RayPacket<K>& ray,
+void walk(const Octree& tree, const PacketRecordIntersector<vfloat<K>>& isect, RayPacket<K>& ray,
           HitPacket<K>& hit, vmask<K> group, unsigned a, vmask<K>& occluded) {
     using F = vfloat<K>;
     using M = vmask<K>;
@@ -165,7 +165,7 @@ void walk(const Octree& tree, const PacketPrimitiveIntersector<vfloat<K>>& isect
 }
 
 template <int K, bool AnyHit, SlabMethod Slabs>
-void trace_packet(const Octree& tree, const PacketPrimitiveIntersector<vfloat<K>>& isect, RayPacket<K>& ray,
+void trace_packet(const Octree& tree, const PacketRecordIntersector<vfloat<K>>& isect, RayPacket<K>& ray,
                   HitPacket<K>& hit, vmask<K> valid, vmask<K>& occluded) {
     using F = vfloat<K>;
     using M = vmask<K>;
@@ -264,7 +264,7 @@ RAYPACK_INLINE int packet_octant(const LoadedPacket<K>& p) {
 // back for every lane of every packet. Returns false, tracing nothing, if
 // the packets do not share one octant.
 template <int K, bool AnyHit, SlabMethod Slabs>
-bool trace_group(const Octree& tree, const PacketPrimitiveIntersector<vfloat<K>>& isect, LoadedPacket<K>* p,
+bool trace_group(const Octree& tree, const PacketRecordIntersector<vfloat<K>>& isect, LoadedPacket<K>* p,
                  int count) {
     using F = vfloat<K>;
     using M = vmask<K>;
@@ -408,14 +408,15 @@ bool trace_group(const Octree& tree, const PacketPrimitiveIntersector<vfloat<K>>
 }  // namespace
 
 template <int K, bool AnyHit>
-void octree_trace_packets(const Octree& tree, const Scene& scene, KernelChoice kernels, std::span<const Rayf> rays,
+void octree_trace_packets(const Octree& tree, const Scene& scene, KernelChoice kernels,
+                        const TriangleEdgeRecord* triangle_edges, std::span<const Rayf> rays,
                           std::span<Hitf> hits, bool groups) {
     using F = vfloat<K>;
     if (tree.empty()) {
         for (auto& h : hits) h = Hitf{};
         return;
     }
-    const PacketPrimitiveIntersector<F> isect{&scene, kernels};
+    const PacketRecordIntersector<F> isect{&scene, kernels, triangle_edges};
     // The slab form is chosen once for all packets, rdir once per packet.
     with_slab_form(kernels.slabs, [&]<SlabMethod Slabs>(SlabTag<Slabs>) {
         const auto trace_one = [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid, vmask<K>& occluded) {
@@ -439,21 +440,21 @@ void octree_trace_packets(const Octree& tree, const Scene& scene, KernelChoice k
 }
 
 #if defined(__SSE4_2__)
-template void octree_trace_packets<4, false>(const Octree&, const Scene&, KernelChoice, std::span<const Rayf>,
+template void octree_trace_packets<4, false>(const Octree&, const Scene&, KernelChoice, const TriangleEdgeRecord*, std::span<const Rayf>,
                                              std::span<Hitf>, bool);
-template void octree_trace_packets<4, true>(const Octree&, const Scene&, KernelChoice, std::span<const Rayf>,
+template void octree_trace_packets<4, true>(const Octree&, const Scene&, KernelChoice, const TriangleEdgeRecord*, std::span<const Rayf>,
                                             std::span<Hitf>, bool);
 #endif
 #if defined(__AVX2__)
-template void octree_trace_packets<8, false>(const Octree&, const Scene&, KernelChoice, std::span<const Rayf>,
+template void octree_trace_packets<8, false>(const Octree&, const Scene&, KernelChoice, const TriangleEdgeRecord*, std::span<const Rayf>,
                                              std::span<Hitf>, bool);
-template void octree_trace_packets<8, true>(const Octree&, const Scene&, KernelChoice, std::span<const Rayf>,
+template void octree_trace_packets<8, true>(const Octree&, const Scene&, KernelChoice, const TriangleEdgeRecord*, std::span<const Rayf>,
                                             std::span<Hitf>, bool);
 #endif
 #if defined(__AVX512BW__)
-template void octree_trace_packets<16, false>(const Octree&, const Scene&, KernelChoice, std::span<const Rayf>,
+template void octree_trace_packets<16, false>(const Octree&, const Scene&, KernelChoice, const TriangleEdgeRecord*, std::span<const Rayf>,
                                               std::span<Hitf>, bool);
-template void octree_trace_packets<16, true>(const Octree&, const Scene&, KernelChoice, std::span<const Rayf>,
+template void octree_trace_packets<16, true>(const Octree&, const Scene&, KernelChoice, const TriangleEdgeRecord*, std::span<const Rayf>,
                                              std::span<Hitf>, bool);
 #endif
 

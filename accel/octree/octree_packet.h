@@ -25,7 +25,8 @@ inline constexpr int kOctreeGroupPackets = 8;
 /// (octree_packet.cpp, trace_group), with the same answers. Defined for the
 /// K that are compiled in (see kWidthCompiled).
 template <int K, bool AnyHit>
-void octree_trace_packets(const Octree& tree, const Scene& scene, KernelChoice kernels, std::span<const Rayf> rays,
+void octree_trace_packets(const Octree& tree, const Scene& scene, KernelChoice kernels,
+                        const TriangleEdgeRecord* triangle_edges, std::span<const Rayf> rays,
                           std::span<Hitf> hits, bool groups = true);
 
 }  // namespace raypack
