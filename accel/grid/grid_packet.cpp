@@ -46,22 +46,22 @@ void grid_trace_packets(const Grid& grid, const Scene& scene, KernelChoice kerne
 }
 
 #if defined(__SSE4_2__)
-template void grid_trace_packets<4, false>(const Grid&, const Scene&, KernelChoice, const TriangleEdgeRecord*, bool, std::span<const Rayf>,
-                                              std::span<Hitf>);
-template void grid_trace_packets<4, true>(const Grid&, const Scene&, KernelChoice, const TriangleEdgeRecord*, bool, std::span<const Rayf>,
-                                              std::span<Hitf>);
+template void grid_trace_packets<4, false>(const Grid&, const Scene&, KernelChoice, const TriangleEdgeRecord*,
+                                           bool, std::span<const Rayf>, std::span<Hitf>);
+template void grid_trace_packets<4, true>(const Grid&, const Scene&, KernelChoice, const TriangleEdgeRecord*,
+                                          bool, std::span<const Rayf>, std::span<Hitf>);
 #endif
 #if defined(__AVX2__)
-template void grid_trace_packets<8, false>(const Grid&, const Scene&, KernelChoice, const TriangleEdgeRecord*, bool, std::span<const Rayf>,
-                                              std::span<Hitf>);
-template void grid_trace_packets<8, true>(const Grid&, const Scene&, KernelChoice, const TriangleEdgeRecord*, bool, std::span<const Rayf>,
-                                              std::span<Hitf>);
+template void grid_trace_packets<8, false>(const Grid&, const Scene&, KernelChoice, const TriangleEdgeRecord*,
+                                           bool, std::span<const Rayf>, std::span<Hitf>);
+template void grid_trace_packets<8, true>(const Grid&, const Scene&, KernelChoice, const TriangleEdgeRecord*,
+                                          bool, std::span<const Rayf>, std::span<Hitf>);
 #endif
 #if defined(__AVX512BW__)
-template void grid_trace_packets<16, false>(const Grid&, const Scene&, KernelChoice, const TriangleEdgeRecord*, bool, std::span<const Rayf>,
-                                              std::span<Hitf>);
-template void grid_trace_packets<16, true>(const Grid&, const Scene&, KernelChoice, const TriangleEdgeRecord*, bool, std::span<const Rayf>,
-                                              std::span<Hitf>);
+template void grid_trace_packets<16, false>(const Grid&, const Scene&, KernelChoice, const TriangleEdgeRecord*,
+                                            bool, std::span<const Rayf>, std::span<Hitf>);
+template void grid_trace_packets<16, true>(const Grid&, const Scene&, KernelChoice, const TriangleEdgeRecord*,
+                                           bool, std::span<const Rayf>, std::span<Hitf>);
 #endif
 
 }  // namespace raypack

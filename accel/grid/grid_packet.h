@@ -24,7 +24,8 @@ bool grid_packets_exact(const Grid& grid);
 /// single-ray walk's answers, ties between primitives at the same t aside);
 /// the others, or all if not `coherent`, step each lane's own DDA, with the
 /// same answers as the single-ray walk without mailbox, bit for bit.
-/// Defined for the K that are compiled in (see kWidthCompiled).
+/// `triangle_edges`: the grid's triangle records (accel/prims/triangle_edges.h)
+/// or null. Defined for the K that are compiled in (see kWidthCompiled).
 template <int K, bool AnyHit>
 void grid_trace_packets(const Grid& grid, const Scene& scene, KernelChoice kernels,
                         const TriangleEdgeRecord* triangle_edges, bool coherent,

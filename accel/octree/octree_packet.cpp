@@ -409,7 +409,7 @@ bool trace_group(const Octree& tree, const PacketRecordIntersector<vfloat<K>>& i
 
 template <int K, bool AnyHit>
 void octree_trace_packets(const Octree& tree, const Scene& scene, KernelChoice kernels,
-                        const TriangleEdgeRecord* triangle_edges, std::span<const Rayf> rays,
+                          const TriangleEdgeRecord* triangle_edges, std::span<const Rayf> rays,
                           std::span<Hitf> hits, bool groups) {
     using F = vfloat<K>;
     if (tree.empty()) {
@@ -440,22 +440,22 @@ void octree_trace_packets(const Octree& tree, const Scene& scene, KernelChoice k
 }
 
 #if defined(__SSE4_2__)
-template void octree_trace_packets<4, false>(const Octree&, const Scene&, KernelChoice, const TriangleEdgeRecord*, std::span<const Rayf>,
-                                             std::span<Hitf>, bool);
-template void octree_trace_packets<4, true>(const Octree&, const Scene&, KernelChoice, const TriangleEdgeRecord*, std::span<const Rayf>,
-                                            std::span<Hitf>, bool);
+template void octree_trace_packets<4, false>(const Octree&, const Scene&, KernelChoice,
+                                             const TriangleEdgeRecord*, std::span<const Rayf>, std::span<Hitf>, bool);
+template void octree_trace_packets<4, true>(const Octree&, const Scene&, KernelChoice,
+                                            const TriangleEdgeRecord*, std::span<const Rayf>, std::span<Hitf>, bool);
 #endif
 #if defined(__AVX2__)
-template void octree_trace_packets<8, false>(const Octree&, const Scene&, KernelChoice, const TriangleEdgeRecord*, std::span<const Rayf>,
-                                             std::span<Hitf>, bool);
-template void octree_trace_packets<8, true>(const Octree&, const Scene&, KernelChoice, const TriangleEdgeRecord*, std::span<const Rayf>,
-                                            std::span<Hitf>, bool);
+template void octree_trace_packets<8, false>(const Octree&, const Scene&, KernelChoice,
+                                             const TriangleEdgeRecord*, std::span<const Rayf>, std::span<Hitf>, bool);
+template void octree_trace_packets<8, true>(const Octree&, const Scene&, KernelChoice,
+                                            const TriangleEdgeRecord*, std::span<const Rayf>, std::span<Hitf>, bool);
 #endif
 #if defined(__AVX512BW__)
-template void octree_trace_packets<16, false>(const Octree&, const Scene&, KernelChoice, const TriangleEdgeRecord*, std::span<const Rayf>,
-                                              std::span<Hitf>, bool);
-template void octree_trace_packets<16, true>(const Octree&, const Scene&, KernelChoice, const TriangleEdgeRecord*, std::span<const Rayf>,
-                                             std::span<Hitf>, bool);
+template void octree_trace_packets<16, false>(const Octree&, const Scene&, KernelChoice,
+                                              const TriangleEdgeRecord*, std::span<const Rayf>, std::span<Hitf>, bool);
+template void octree_trace_packets<16, true>(const Octree&, const Scene&, KernelChoice,
+                                             const TriangleEdgeRecord*, std::span<const Rayf>, std::span<Hitf>, bool);
 #endif
 
 }  // namespace raypack

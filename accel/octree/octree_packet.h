@@ -22,11 +22,13 @@ inline constexpr int kOctreeGroupPackets = 8;
 /// Closest hits (AnyHit = false) or occlusion (AnyHit = true, hits[i].prim
 /// = 0 where occluded) of `rays` in packets of K; with `groups`, packets
 /// whose rays share a direction octant walk the tree kOctreeGroupPackets at a time
-/// (octree_packet.cpp, trace_group), with the same answers. Defined for the
-/// K that are compiled in (see kWidthCompiled).
+/// (octree_packet.cpp, trace_group), with the same answers.
+/// `triangle_edges`: the octree's triangle records
+/// (accel/prims/triangle_edges.h) or null. Defined for the K that are
+/// compiled in (see kWidthCompiled).
 template <int K, bool AnyHit>
 void octree_trace_packets(const Octree& tree, const Scene& scene, KernelChoice kernels,
-                        const TriangleEdgeRecord* triangle_edges, std::span<const Rayf> rays,
+                          const TriangleEdgeRecord* triangle_edges, std::span<const Rayf> rays,
                           std::span<Hitf> hits, bool groups = true);
 
 }  // namespace raypack
