@@ -18,8 +18,8 @@ namespace raypack {
 /// else from their vertices. A compile-time choice, because the choice
 /// itself costs: the k-d tree's group walk ran 7-12% slower with the
 /// run-time test in its leaf loop even with no records (GCC compiled the
-/// loop worse), and 2-4% slower with them, while the octree's and the
-/// grid's walks gained 4-10% (Zen 5, camera rays; docs/structures.md).
+/// loop worse), and 2-4% slower with them, while the octree's walks gained
+/// 3-10% and the grid's 2-5% (Zen 5, camera rays; docs/structures.md).
 template <class F, bool TriangleRecords = false>
 struct PacketPrimitiveIntersector {
     const Scene* scene;
