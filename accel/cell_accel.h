@@ -35,11 +35,11 @@ public:
                          TraversalCounts& counts) const override;
 
     bool supports_packet(int width) const override;
+    void intersect_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const override;
+    void occluded_packets(int width, std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override;
 
     /// Memory of the triangle records (make_triangle_edges), part of stats().bytes.
     std::size_t triangle_edge_bytes() const { return triangle_edges_.bytes(); }
-    void intersect_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const override;
-    void occluded_packets(int width, std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override;
 
 protected:
     /// Moeller's records of the scene's triangles for the leaves' tests

@@ -3,7 +3,6 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-
 namespace raypack {
 
 TriangleEdgeTable::TriangleEdgeTable(const Scene& scene) : records_(scene.triangles.size()) {

@@ -1,11 +1,11 @@
 #pragma once
 // Moeller-Trumbore's per-triangle part (p0, p0 - p1, p2 - p0 and their cross
 // product) of every triangle of a scene, computed once when a structure is
-// built, for the structures whose leaves hold primitive numbers (uniform
-// and two-level grid, k-d tree, octree). Their tests went through the
-// scene's vertices and formed the edges and the normal at every ray-triangle
-// test: twelve more vector operations on a test of about thirty. The BVHs'
-// leaf blocks hold the same values (TriangleLayout::Edges).
+// built, for the octree and the grids, whose leaves hold primitive numbers:
+// their tests read the scene's vertices and formed the edges and the normal
+// at every ray-triangle test. The BVHs' leaf blocks hold the same values
+// (TriangleLayout::Edges); the k-d tree measured no faster with them
+// (docs/structures.md) and keeps the vertices.
 #include <cstddef>
 #include <cstdint>
 #include <vector>
