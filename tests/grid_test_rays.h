@@ -88,17 +88,17 @@ inline std::vector<Rayf> grid_adversarial_rays(const GridGeometry& g, const Scen
     return rays;
 }
 
-/// Bundles of 16 rays around each base ray that share its major direction:
+/// Bundles of `rays_per_base` rays around each base ray that share its major direction:
 /// the base ray itself (unchanged, so the bundle keeps its edge case) and
 /// copies with origins moved by up to `spread_origin` and directions tilted
 /// by up to `spread_dir` radians.
 inline std::vector<Rayf> bundles(const std::vector<Rayf>& base, std::mt19937& rng, float spread_origin,
-                                 float spread_dir) {
+                                 float spread_dir, int rays_per_base = 16) {
     std::uniform_real_distribution<float> u(-1, 1);
     std::vector<Rayf> rays;
     for (const Rayf& b : base) {
         const float len = length(b.dir);
-        for (int l = 0; l < 16; ++l) {
+        for (int l = 0; l < rays_per_base; ++l) {
             Rayf r = b;
             if (l > 0) {
                 r.org = b.org + Vec3f{u(rng), u(rng), u(rng)} * spread_origin;

@@ -29,6 +29,7 @@
 #include "accel/accel.h"
 #include "accel/brute/brute_force.h"
 #include "accel/grid/coherent_grid.h"
+#include "accel/grid/coherent_grid_group.h"
 #include "accel/grid/dda.h"
 #include "accel/grid/dda_packet.h"
 #include "accel/grid/grid_accel.h"
@@ -83,7 +84,8 @@ TEST_P(Grid, MatchesBruteForce) {
         nonempty += grid.grid().cell_begin[c + 1] > grid.grid().cell_begin[c];
     EXPECT_EQ(s.leaves, nonempty);
     EXPECT_DOUBLE_EQ(grid.empty_cell_fraction(), 1.0 - double(nonempty) / double(grid.cell_count()));
-    EXPECT_EQ(s.bytes, (grid.cell_count() + 1 + grid.reference_count()) * sizeof(std::uint32_t) +
+    EXPECT_EQ(s.bytes, (grid.cell_count() + 1 + grid.reference_count() + grid.grid().outside.size()) *
+                               sizeof(std::uint32_t) +
                            grid.grid().macro.full.size() + grid.triangle_edge_bytes());
     EXPECT_GE(grid.references_per_primitive(), 1.0);
     const double cells_per_prim = double(grid.cell_count()) / double(scene.primitive_count());
@@ -661,10 +663,14 @@ TEST_F(Grid, MacrocellsMarkExactlyTheOccupiedBlocks) {
 }
 
 /// Packets of width K through the coherent walk directly, against brute
-/// force. Where the walk leaves off (its rays diverged), brute force over
-/// what is left of each remaining lane (up to its closest hit so far)
-/// finishes it. Returns how many closest-hit packets the walk finished.
-template <int K>
+/// force: G = 1, each packet alone (coherent_grid.h); G > 1, groups of G
+/// consecutive packets (coherent_grid_group.h), as grid_packet.cpp forms
+/// them. The grid's primitives outside its cells are tested first, as there.
+/// Where the walk leaves off (its rays diverged, or a group does not share
+/// one major direction), brute force over what is left of each remaining
+/// lane (up to its closest hit so far) finishes it. Returns how many
+/// closest-hit packets the walk finished.
+template <int K, int G = 1>
 int expect_coherent_walk_matches(const GridAccel& grid, const Scene& scene, const std::vector<Rayf>& rays,
                                  const std::string& what) {
     using F = vfloat<K>;
@@ -676,53 +682,74 @@ int expect_coherent_walk_matches(const GridAccel& grid, const Scene& scene, cons
     std::vector<std::uint8_t> occluded(rays.size()), want_occluded(rays.size());
     for (std::size_t i = 0; i < rays.size(); ++i) want_occluded[i] = truth[i].found();
     int finished = 0;
-    for (std::size_t first = 0; first + K <= rays.size(); first += K) {
+    for (std::size_t first = 0; first + G * K <= rays.size(); first += G * K) {
         for (const bool any_hit : {false, true}) {
-            vmask<K> valid;
-            RayPacket<K> ray = load_packet<K>(std::span<const Rayf>(rays).subspan(first, K), valid);
-            HitPacket<K> hit;
-            hit.t = F(std::numeric_limits<float>::infinity());
-            hit.u = hit.v = F(0.0f);
-            for (auto& p : hit.prim) p = kNoPrim;
-            vmask<K> occ = valid & !valid;
-            const SlabRay<F> slab = make_slab_ray(ray.org, ray.rdir, ray.tnear, ray.tfar);
-            F entry;
-            vmask<K> active =
-                intersect_box<SlabMethod::Robust, F>(valid, slab, splat<F>(g.bounds.lo), splat<F>(g.bounds.hi), entry);
-            const int k = any(active) ? coherent_grid::major_axis<K>(ray, active) : -1;
-            std::uint32_t left = 0;
-            if (k >= 0) {
-                const bool done =
-                    any_hit ? coherent_grid::trace<K, true>(grid.grid(), isect, k, ray, hit, active, entry, occ)
-                            : coherent_grid::trace<K, false>(grid.grid(), isect, k, ray, hit, active, entry, occ);
-                if (!done) left = mask_bits(active);
-                finished += done && !any_hit;
-            } else {
-                left = mask_bits(active);  // not coherent: all of it by brute force
-            }
-            alignas(64) float t[K], u[K], v[K], tfar[K];
-            store_lanes(t, hit.t), store_lanes(u, hit.u), store_lanes(v, hit.v), store_lanes(tfar, ray.tfar);
-            const std::uint32_t o = mask_bits(occ);
-            for (int l = 0; l < K; ++l) {
-                const std::size_t i = first + std::size_t(l);
-                Hitf h{t[l], hit.prim[l], u[l], v[l]};
-                if ((left >> l) & 1u) {
-                    Rayf rest = rays[i];
-                    rest.tfar = any_hit ? rest.tfar : tfar[l];
-                    const Hitf b = brute.intersect1(rest);
-                    if (b.found()) h = b;
-                    if (any_hit) occluded[i] = b.found();
+            LoadedPacket<K> p[G];
+            coherent_grid::GroupLanes<K, G> lanes;
+            std::uint32_t left[G] = {};
+            for (int q = 0; q < G; ++q) {
+                load_fresh_packet<K>(rays, first + std::size_t(q) * K, RcpMethod::Exact, p[q]);
+                for (const std::uint32_t prim : grid.grid().outside) {
+                    const vmask<K> m = isect.intersect(p[q].valid, p[q].ray, p[q].hit, prim);
+                    if (any_hit) p[q].occluded = p[q].occluded | m, p[q].valid = p[q].valid & !m;
                 }
-                if (any_hit) occluded[i] |= (o >> l) & 1u;
-                else got[i] = h;
+                const SlabRay<F> slab = make_slab_ray(p[q].ray.org, p[q].ray.rdir, p[q].ray.tnear, p[q].ray.tfar);
+                F entry;
+                const vmask<K> active = intersect_box<SlabMethod::Robust, F>(
+                    p[q].valid, slab, splat<F>(g.bounds.lo), splat<F>(g.bounds.hi), entry);
+                if (none(active)) continue;
+                left[q] = mask_bits(active);  // until the walk takes them
+                lanes.packet[lanes.count] = &p[q];
+                lanes.active[lanes.count] = active;
+                lanes.entry[lanes.count++] = entry;
+            }
+            const int k = coherent_grid::group_major_axis<K, G>(lanes);
+            if (k >= 0) {
+                bool done;
+                if constexpr (G == 1) {
+                    LoadedPacket<K>& one = *lanes.packet[0];
+                    done = any_hit ? coherent_grid::trace<K, true>(grid.grid(), isect, k, one.ray, one.hit,
+                                                                   lanes.active[0], lanes.entry[0], one.occluded)
+                                   : coherent_grid::trace<K, false>(grid.grid(), isect, k, one.ray, one.hit,
+                                                                    lanes.active[0], lanes.entry[0], one.occluded);
+                } else {
+                    done = any_hit ? coherent_grid::trace_group<K, G, true>(grid.grid(), isect, k, lanes)
+                                   : coherent_grid::trace_group<K, G, false>(grid.grid(), isect, k, lanes);
+                }
+                for (int q = 0; q < lanes.count; ++q) {
+                    const auto at = std::size_t(lanes.packet[q] - p);
+                    left[at] = done ? 0u : mask_bits(lanes.active[q]);
+                }
+                finished += done && !any_hit ? lanes.count : 0;
+            }
+            for (int q = 0; q < G; ++q) {
+                alignas(64) float t[K], u[K], v[K], tfar[K];
+                store_lanes(t, p[q].hit.t), store_lanes(u, p[q].hit.u), store_lanes(v, p[q].hit.v);
+                store_lanes(tfar, p[q].ray.tfar);
+                const std::uint32_t o = mask_bits(p[q].occluded);
+                for (int l = 0; l < K; ++l) {
+                    const std::size_t i = first + std::size_t(q) * K + std::size_t(l);
+                    Hitf h{t[l], p[q].hit.prim[l], u[l], v[l]};
+                    if ((left[q] >> l) & 1u) {
+                        Rayf rest = rays[i];
+                        rest.tfar = any_hit ? rest.tfar : tfar[l];
+                        const Hitf b = brute.intersect1(rest);
+                        if (b.found()) h = b;
+                        if (any_hit) occluded[i] = b.found();
+                    }
+                    if (any_hit) occluded[i] |= (o >> l) & 1u;
+                    else got[i] = h;
+                }
             }
         }
     }
     std::size_t n = 0;
     const std::string hits = hit_mismatches(rays, truth, got, n);
-    EXPECT_EQ(n, 0u) << what << " K=" << K << ": " << n << " of " << rays.size() << " closest hits differ" << hits;
+    EXPECT_EQ(n, 0u) << what << " K=" << K << " G=" << G << ": " << n << " of " << rays.size()
+                     << " closest hits differ" << hits;
     const std::string occ = occlusion_mismatches(rays, want_occluded, occluded, n);
-    EXPECT_EQ(n, 0u) << what << " K=" << K << ": " << n << " of " << rays.size() << " occlusion answers differ" << occ;
+    EXPECT_EQ(n, 0u) << what << " K=" << K << " G=" << G << ": " << n << " of " << rays.size()
+                     << " occlusion answers differ" << occ;
     return finished;
 }
 
@@ -740,6 +767,10 @@ void expect_coherent_walks(const std::string& file, std::mt19937& rng, int bundl
         camera.insert(camera.end(), full.begin() + y * 512 + 224, full.begin() + y * 512 + 288);
     const int finished = expect_coherent_walk_matches<K>(*grid, scene, camera, file + " camera");
     EXPECT_GE(finished, int(camera.size() / K) * 3 / 4) << file << " K=" << K;
+    // The same in groups of 128 rays (two rows of the window's 64 pixels).
+    constexpr int G = 128 / K;
+    const int group_finished = expect_coherent_walk_matches<K, G>(*grid, scene, camera, file + " camera");
+    EXPECT_GE(group_finished, int(camera.size() / K) * 3 / 4) << file << " K=" << K << " G=" << G;
     // Tight bundles around rays that make a DDA stumble (cell edges, planes,
     // corners, axis-parallel, far origins, tnear and tfar inside the grid):
     // every bundle keeps its base ray exactly.
@@ -747,10 +778,63 @@ void expect_coherent_walks(const std::string& file, std::mt19937& rng, int bundl
     const std::vector<Rayf> few(adversarial.begin(),
                                 adversarial.begin() + std::ptrdiff_t(adversarial.size() * std::size_t(bundle_count) / 1600));
     expect_coherent_walk_matches<K>(*grid, scene, bundles(few, rng, 0.25f * cell, 1e-3f), file + " edge bundles");
+    // Groups: 128 rays around each of every eighth base ray, a group of
+    // packets to each (as many rays as above).
+    auto every_eighth = [](const std::vector<Rayf>& base) {
+        std::vector<Rayf> some;
+        for (std::size_t i = 0; i < base.size(); i += 8) some.push_back(base[i]);
+        return some;
+    };
+    expect_coherent_walk_matches<K, G>(*grid, scene, bundles(every_eighth(few), rng, 0.25f * cell, 1e-3f, G * K),
+                                       file + " edge bundles");
     // Random bundles, tight and loose; loose ones leave the walk on the way.
     const std::vector<Rayf> random = random_rays(scene, rng, bundle_count, kOriginGrowth);
     expect_coherent_walk_matches<K>(*grid, scene, bundles(random, rng, 2.0f * cell, 0.01f), file + " bundles");
     expect_coherent_walk_matches<K>(*grid, scene, bundles(random, rng, 0.0f, 0.6f), file + " fans");
+    expect_coherent_walk_matches<K, G>(*grid, scene, bundles(every_eighth(random), rng, 2.0f * cell, 0.01f, G * K),
+                                       file + " bundles");
+}
+
+TEST_F(Grid, LargePrimitivesStayOutsideTheCells) {
+    // A ground polygon under a small object (SPD balls and tree: the ground
+    // comes first in their files): its triangles are tested by every ray and
+    // the cells fit the rest; the tree's trunk goes too (it reaches down to
+    // the ground). Scenes without one keep everything in cells.
+    const std::pair<const char*, std::vector<std::uint32_t>> cases[] = {
+        {"balls.nff", {0, 1}}, {"tree.nff", {0, 1, 2}}, {"rings.nff", {}}, {"tetra.nff", {}},
+        {"mount.nff", {}},     {"teapot.nff", {}},      {"gears.nff", {}}};
+    for (const auto& [file, want] : cases) {
+        const Scene scene = load_scene(std::string(RAYPACK_SOURCE_DIR) + "/scenes/" + file);
+        const auto grid = make_grid(scene);
+        EXPECT_EQ(grid->grid().outside, want) << file;
+        if (want.empty()) continue;
+        // The grid's box is the rest's, and shrank at least kMinShrink-fold.
+        Box3f rest, all;
+        for (std::uint32_t p = 0; p < scene.primitive_count(); ++p) {
+            all.extend(primitive_bounds(scene, p));
+            if (std::find(want.begin(), want.end(), p) == want.end()) rest.extend(primitive_bounds(scene, p));
+        }
+        const Box3f& box = grid->grid().geometry.bounds;
+        for (int a = 0; a < 3; ++a) {
+            EXPECT_LE(box.lo[a], rest.lo[a]) << file;
+            EXPECT_GE(box.hi[a], rest.hi[a]) << file;
+        }
+        EXPECT_GE(all.half_area(), kMinShrink * box.half_area()) << file;
+        // Camera rays: the same hits as the classic grid (the ground in its
+        // cells) with several times fewer primitive tests.
+        GridConfig classic_config;
+        classic_config.large_primitives_outside = false;
+        const auto classic = make_grid(scene, classic_config);
+        EXPECT_TRUE(classic->grid().outside.empty());
+        GridRayCounters fitted_counts, classic_counts;
+        for (const Rayf& r : camera_rays(scene, 64)) {
+            const Hitf a = grid->intersect_counting(r, fitted_counts), b = classic->intersect_counting(r, classic_counts);
+            EXPECT_EQ(a.prim, b.prim) << file;
+            EXPECT_EQ(a.t, b.t) << file;
+        }
+        EXPECT_LT(fitted_counts.prim_tests * 3, classic_counts.prim_tests)
+            << file << ": " << fitted_counts.prim_tests << " tests against " << classic_counts.prim_tests;
+    }
 }
 
 TEST_F(Grid, CoherentWalkMatchesBruteForce) {

@@ -66,6 +66,19 @@ RAYPACK_INLINE int major_axis(const RayPacket<K>& ray, const vmask<K>& active) {
     return (mask_bits(same) & bits) == bits ? k : -1;
 }
 
+/// Whether a macrocell of layer `block` along axis k under the cells
+/// [first, last] (along the axes after k) holds any reference.
+RAYPACK_INLINE bool any_macrocell(const MacroCells& macro, int k, int block, const int first[2], const int last[2]) {
+    const int u = (k + 1) % 3, v = (k + 2) % 3;
+    for (int j = first[1] >> macro.shift; j <= last[1] >> macro.shift; ++j)
+        for (int i = first[0] >> macro.shift; i <= last[0] >> macro.shift; ++i) {
+            int c[3];
+            c[k] = block, c[u] = i, c[v] = j;
+            if (macro.any(c[0], c[1], c[2])) return true;
+        }
+    return false;
+}
+
 /// Cells per active lane above which a slice's rectangle ends the coherent
 /// walk: the lanes then diverge, and stepping each lane's own DDA visits
 /// fewer cells than the rectangle holds. Measured (docs/structures.md): 2,
@@ -164,15 +177,7 @@ bool walk(const Grid& grid, int k, const RayPacket<K>& ray, vmask<K>& active, vf
         const int block = s >> macro.shift;
         const int block_end = up ? std::min(res_k - 1, ((block + 1) << macro.shift) - 1) : block << macro.shift;
         int first[2], last[2];
-        bool full = false;
-        if (rectangle(std::min(s, block_end), std::max(s, block_end) + 1, first, last)) {
-            for (int j = first[1] >> macro.shift; j <= last[1] >> macro.shift && !full; ++j)
-                for (int i = first[0] >> macro.shift; i <= last[0] >> macro.shift && !full; ++i) {
-                    int c[3];
-                    c[k] = block, c[u] = i, c[v] = j;
-                    full = macro.any(c[0], c[1], c[2]);
-                }
-        }
+        const bool full = rectangle(std::min(s, block_end), std::max(s, block_end) + 1, first, last) && any_macrocell(macro, k, block, first, last);
         if (!full) {
             if (stop_before(up ? block_end + 1 : block_end)) return true;
             s = block_end + step;

@@ -42,6 +42,11 @@ struct GridConfig {
     /// (coherent grid traversal, coherent_grid.h); false: every packet steps
     /// each lane's own DDA (dda_packet.h), for comparison and tests.
     bool coherent_packets = true;
+    /// A few primitives far larger than the rest (a ground polygon under a
+    /// small object: SPD balls, rings, tree) are tested by every ray instead
+    /// of being placed in cells, so that the grid's box, and with it the
+    /// cells, fit the rest (large_primitives() in grid_build.h).
+    bool large_primitives_outside = true;
     /// Cells are widened by at least this much when primitives are placed
     /// (grid_build.h); a sub-grid of a two-level grid takes its parent's.
     float min_placement_margin = 0.0f;
@@ -81,10 +86,13 @@ struct Grid {
     std::vector<std::uint32_t> refs;        ///< primitive numbers, sorted within each cell
     float lambda = 0;                       ///< the density actually used (lowered if references overflowed)
     MacroCells macro;
+    /// Primitives in no cell, tested by every ray before the walk
+    /// (GridConfig::large_primitives_outside).
+    std::vector<std::uint32_t> outside;
 
-    bool empty() const { return refs.empty(); }
+    bool empty() const { return refs.empty(); }  ///< no cell holds anything (`outside` may)
     std::size_t bytes() const {
-        return (cell_begin.size() + refs.size()) * sizeof(std::uint32_t) + macro.full.size();
+        return (cell_begin.size() + refs.size() + outside.size()) * sizeof(std::uint32_t) + macro.full.size();
     }
 };
 

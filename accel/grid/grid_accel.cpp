@@ -23,8 +23,14 @@ GridAccel::GridAccel(const Scene& scene, const AccelConfig& config, const GridCo
     const std::size_t n = scene.primitive_count();
     std::vector<Box3f> boxes(n);
     tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) { boxes[i] = primitive_bounds(scene, std::uint32_t(i)); });
+    std::vector<std::uint32_t> outside;
+    if (grid_config.large_primitives_outside) {
+        outside = large_primitives(boxes);
+        for (std::uint32_t p : outside) boxes[p] = Box3f{};  // an empty box: in no cell
+    }
     const PrimitiveBoxOverlap exact{&scene};
     grid_ = build_grid(boxes, grid_config.exact_overlap ? &exact : nullptr, grid_config);
+    grid_.outside = std::move(outside);
     for (std::size_t c = 0; c < grid_.geometry.cells(); ++c) empty_cells_ += grid_.cell_begin[c] == grid_.cell_begin[c + 1];
     stats_.name = "grid";
     stats_.builder = "uniform";
@@ -58,13 +64,22 @@ double GridAccel::empty_cell_fraction() const {
 template <bool AnyHit, bool Counting, bool Mailbox, SlabMethod Slabs>
 bool GridAccel::trace(Rayf& ray, Hitf& hit, GridRayCounters* counters) const {
     if constexpr (Counting) ++counters->rays;
-    if (grid_.empty()) return false;
+    const PrimitiveIntersector<float> isect{scene_, kernels_, triangle_edges()};
+    bool found = false;
+    // The primitives outside the cells first: a hit there shortens the walk.
+    for (const std::uint32_t prim : grid_.outside) {
+        if constexpr (Counting) ++counters->prim_tests;
+        if (isect.intersect(prim, ray, hit)) {
+            found = true;
+            if constexpr (AnyHit) return true;
+        }
+    }
+    if (grid_.empty()) return found;
     const Vec3f inv_dir = ray_reciprocal(ray.dir, kernels_.rcp);
     float entry;
     const SlabRay<float> slab = make_slab_ray(ray.org, inv_dir, ray.tnear, ray.tfar);
     if (!intersect_box<Slabs, float>(true, slab, grid_.geometry.bounds.lo, grid_.geometry.bounds.hi, entry))
-        return false;
-    const PrimitiveIntersector<float> isect{scene_, kernels_, triangle_edges()};
+        return found;
     const std::uint32_t* begin = grid_.cell_begin.data();
     const std::uint32_t* refs = grid_.refs.data();
     // Direct-mapped on the primitive number: a collision only costs a re-test.
@@ -72,7 +87,6 @@ bool GridAccel::trace(Rayf& ray, Hitf& hit, GridRayCounters* counters) const {
     std::uint32_t mailbox[Mailbox ? kMailboxSize : 1];
     if constexpr (Mailbox) std::fill(mailbox, mailbox + kMailboxSize, kNoPrim);
     GridDda dda(grid_.geometry, ray.org, ray.dir, inv_dir, entry, SlabTag<Slabs>{});
-    bool found = false;
     for (;;) {
         // Empty cells (most of them) in a tight loop of their own, which keeps
         // the DDA's state in registers (gcc spills it around the kernel

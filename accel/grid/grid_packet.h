@@ -1,10 +1,12 @@
 #pragma once
-// Packet traversal of the uniform grid. Packets whose rays share a major
-// direction walk the grid slice by slice, the whole packet at once
-// (coherent_grid.h, Wald et al. 2006). Other packets step each lane's own
-// 3D-DDA (dda_packet.h): lanes in empty cells step together, and a cell with
+// Packet traversal of the uniform grid. Consecutive packets whose rays share
+// a major direction walk the grid slice by slice, in groups of 128 rays
+// (coherent_grid_group.h, Wald et al. 2006), or a packet at once
+// (coherent_grid.h). Other packets step each lane's own 3D-DDA
+// (dda_packet.h): lanes in empty cells step together, and a cell with
 // references is tested once, with the packet kernels, for all the lanes that
-// stand in it.
+// stand in it. The grid's primitives outside its cells (Grid::outside) are
+// tested first.
 #include <cstdint>
 #include <span>
 
@@ -20,7 +22,7 @@ bool grid_packets_exact(const Grid& grid);
 
 /// Closest hits (AnyHit = false) or occlusion (AnyHit = true, hits[i].prim
 /// = 0 where occluded) of `rays` in packets of K. `coherent`: packets whose
-/// rays share a major direction walk slice by slice (coherent_grid.h; the
+/// rays share a major direction walk slice by slice (coherent_grid*.h; the
 /// single-ray walk's answers, ties between primitives at the same t aside);
 /// the others, or all if not `coherent`, step each lane's own DDA, with the
 /// same answers as the single-ray walk without mailbox, bit for bit.

@@ -1,0 +1,281 @@
+#pragma once
+// Coherent grid traversal for a group of packets: up to G packets of K rays
+// walk the grid together, slice by slice along their shared major axis.
+// Wald, Ize, Kensler, Knoll and Parker (SIGGRAPH 2006) trace frusta of many
+// rays at once so that the per-slice work (the rectangle of cells, the
+// macrocell test, the loop over the cells and the mailbox) is paid once for
+// all of them; coherent_grid.h walks one packet of K rays, whose rectangle
+// in a slice is already a few cells wide because each ray's own segment in
+// a slice spans about a cell along a diagonal. A group visits the union of
+// its packets' rectangles once.
+//
+// Each primitive of a cell is tested against the packets that have a lane
+// in the slice at hand (the others cannot cross the cell there), once per
+// packet: the mailbox keeps, per primitive, the packets already tested.
+// Exactness is coherent_grid.h's: every cell a lane's segment crosses lies
+// in the group's rectangle of that slice, and the lane's packet is tested
+// against everything in it.
+//
+// Included only by grid_packet.cpp.
+#include <bit>
+#include <cstdint>
+#include <limits>
+
+#include "accel/grid/coherent_grid.h"
+#include "accel/packet_driver.h"
+
+namespace raypack::coherent_grid {
+
+/// Per-primitive record of the packets of a group already tested against
+/// it (direct-mapped; a collision forgets, which only repeats a test).
+class GroupMailbox {
+public:
+    GroupMailbox() { std::fill(std::begin(prim_), std::end(prim_), kNoPrim); }
+    RAYPACK_INLINE std::uint32_t& tested(std::uint32_t prim) {
+        const std::uint32_t slot = prim & (kSlots - 1);
+        if (prim_[slot] != prim) prim_[slot] = prim, packets_[slot] = 0;
+        return packets_[slot];
+    }
+
+private:
+    static constexpr std::uint32_t kSlots = 256;
+    std::uint32_t prim_[kSlots], packets_[kSlots];
+};
+
+/// The packets of a group that walk together: the rays and hits of each,
+/// the lanes still walking and where each enters the grid.
+template <int K, int G>
+struct GroupLanes {
+    LoadedPacket<K>* packet[G];
+    vmask<K> active[G];
+    vfloat<K> entry[G];
+    int count = 0;
+};
+
+/// The major axis every active lane of the group travels along in one
+/// direction (that of the first packet's first lane), or -1.
+template <int K, int G>
+int group_major_axis(const GroupLanes<K, G>& lanes) {
+    if (lanes.count == 0) return -1;
+    const int k = major_axis<K>(lanes.packet[0]->ray, lanes.active[0]);
+    if (k < 0) return -1;
+    const bool up = any(lanes.active[0] & (lanes.packet[0]->ray.dir[k] > vfloat<K>(0.0f)));
+    const vfloat<K> tiny(1e-6f);
+    for (int q = 1; q < lanes.count; ++q) {
+        const vfloat<K> d = lanes.packet[q]->ray.dir[k];
+        const std::uint32_t a = mask_bits(lanes.active[q]);
+        if ((mask_bits(up ? d > tiny : d < -tiny) & a) != a) return -1;
+    }
+    return k;
+}
+
+/// walk() for a group: the major axis k and its sign are shared by every
+/// active lane of every packet (the caller checks). `visit_cell(c, in_slice)`
+/// tests cell c against the packets of the bit set `in_slice` and returns
+/// true once no lane is left. Returns true when the group is done; false
+/// when its rays spread too far apart, with each packet's active lanes and
+/// entries set for it to go on alone.
+template <int K, int G, class VisitCell>
+bool walk_group(const Grid& grid, int k, GroupLanes<K, G>& lanes, VisitCell&& visit_cell) {
+    using F = vfloat<K>;
+    const GridGeometry& g = grid.geometry;
+    const MacroCells& macro = grid.macro;
+    const int u = (k + 1) % 3, v = (k + 2) % 3;
+    const int axes[2] = {u, v};
+    const F inf(std::numeric_limits<float>::infinity());
+    const F rel(kRelativeMargin);
+    const int n = lanes.count;
+
+    const RayPacket<K>& first_ray = lanes.packet[0]->ray;
+    const bool up = (mask_bits(first_ray.dir[k] > F(0.0f)) & mask_bits(lanes.active[0])) != 0;
+    F exit[G];
+    std::uint32_t walking = 0;  // packets with lanes still walking
+    int lane_count = 0;
+    float first_cell = up ? std::numeric_limits<float>::infinity() : -std::numeric_limits<float>::infinity();
+    float slope_lo[2], slope_hi[2];
+    slope_lo[0] = slope_lo[1] = std::numeric_limits<float>::infinity();
+    slope_hi[0] = slope_hi[1] = -std::numeric_limits<float>::infinity();
+    for (int q = 0; q < n; ++q) {
+        const RayPacket<K>& ray = lanes.packet[q]->ray;
+        const vmask<K> a = lanes.active[q];
+        F e = inf;
+        for (int axis = 0; axis < 3; ++axis) {
+            const F t0 = (F(g.bounds.lo[axis]) - ray.org[axis]) * ray.rdir[axis];
+            const F t1 = (F(g.bounds.hi[axis]) - ray.org[axis]) * ray.rdir[axis];
+            const F far = vmax(t0, t1);
+            e = vmin(e, select(far == far, far, inf));
+        }
+        exit[q] = e + vabs(e) * rel;
+        const F start = (ray.org[k] + ray.dir[k] * lanes.entry[q] - F(g.bounds.lo[k])) * F(g.inv_cell_size[k]);
+        first_cell = up ? std::min(first_cell, lane_min<K>(select(a, start, inf)))
+                        : std::max(first_cell, lane_max<K>(select(a, start, -inf)));
+        for (int i = 0; i < 2; ++i) {
+            const F slope = ray.dir[axes[i]] * ray.rdir[k];
+            slope_lo[i] = std::min(slope_lo[i], lane_min<K>(select(a, slope, inf)));
+            slope_hi[i] = std::max(slope_hi[i], lane_max<K>(select(a, slope, -inf)));
+        }
+        walking |= 1u << q;
+        lane_count += std::popcount(mask_bits(a));
+    }
+    // The spread rule of walk(), over all the group's lanes.
+    {
+        float widen[2];
+        for (int i = 0; i < 2; ++i)
+            widen[i] = (slope_hi[i] - slope_lo[i]) * g.cell_size[k] * g.inv_cell_size[axes[i]];
+        const float ahead = float(1 << macro.shift);
+        if (!((1.0f + ahead * widen[0]) * (1.0f + ahead * widen[1]) <= float(kMaxCellsPerLane * lane_count)))
+            return false;
+    }
+    first_cell = up ? first_cell - kCellMargin : first_cell + kCellMargin;
+    const int res_k = g.res[k];
+    int s = first_cell > 0.0f ? (first_cell < float(res_k - 1) ? int(first_cell) : res_k - 1) : 0;
+    const int step = up ? 1 : -1;
+    const std::int32_t stride[3] = {1, g.res[0], g.res[0] * g.res[1]};
+    const std::uint32_t* begin = grid.cell_begin.data();
+
+    auto plane_t = [&](int q, int i) RAYPACK_INLINE_LAMBDA {
+        const RayPacket<K>& ray = lanes.packet[q]->ray;
+        return (F(g.plane(k, i)) - ray.org[k]) * ray.rdir[k];
+    };
+    // Each packet's bounds in the slice at hand (its lanes' segments), kept
+    // to narrow a cell's tests down to the packets whose own rectangle holds
+    // it; reduced to cells only in slices with a non-empty cell.
+    F packet_lo[G][2], packet_hi[G][2];
+    int packet_first[G][2], packet_last[G][2];
+    // The union of the packets' rectangles between planes i0 and i1, and the
+    // packets that have a lane there.
+    auto rectangle = [&](int i0, int i1, int first[2], int last[2], std::uint32_t& in_slice) RAYPACK_INLINE_LAMBDA {
+        F lo[2] = {inf, inf}, hi[2] = {-inf, -inf};
+        in_slice = 0;
+        for (std::uint32_t bits = walking; bits; bits &= bits - 1) {
+            const int q = std::countr_zero(bits);
+            const RayPacket<K>& ray = lanes.packet[q]->ray;
+            const F t0 = plane_t(q, i0), t1 = plane_t(q, i1);
+            const F ta = vmax(vmin(t0, t1), lanes.entry[q]), tb = vmin(vmax(t0, t1), vmin(ray.tfar, exit[q]));
+            const vmask<K> part = lanes.active[q] & (ta <= tb);
+            if (none(part)) continue;
+            in_slice |= 1u << q;
+            for (int i = 0; i < 2; ++i) {
+                const int a = axes[i];
+                const F pa = ray.org[a] + ray.dir[a] * ta, pb = ray.org[a] + ray.dir[a] * tb;
+                const F slack = (vabs(ray.org[a]) + vabs(pa) + vabs(pb)) * rel;
+                packet_lo[q][i] = select(part, vmin(pa, pb) - slack, inf);
+                packet_hi[q][i] = select(part, vmax(pa, pb) + slack, -inf);
+                lo[i] = vmin(lo[i], packet_lo[q][i]);
+                hi[i] = vmax(hi[i], packet_hi[q][i]);
+            }
+        }
+        if (in_slice == 0) return false;
+        for (int i = 0; i < 2; ++i)
+            cell_span(lane_min<K>(lo[i]), lane_max<K>(hi[i]), g.bounds.lo[axes[i]], g.inv_cell_size[axes[i]],
+                      g.res[axes[i]], first[i], last[i]);
+        return true;
+    };
+    auto stop_before = [&](int i) RAYPACK_INLINE_LAMBDA {
+        lane_count = 0;
+        for (std::uint32_t bits = walking; bits; bits &= bits - 1) {
+            const int q = std::countr_zero(bits);
+            const F t_out = plane_t(q, i);
+            const F end = vmin(lanes.packet[q]->ray.tfar, exit[q]);
+            lanes.active[q] = lanes.active[q] & !(end + (vabs(end) + vabs(t_out)) * rel < t_out);
+            const int c = std::popcount(mask_bits(lanes.active[q]));
+            if (c == 0) walking &= ~(1u << q);
+            lane_count += c;
+        }
+        return walking == 0;
+    };
+
+    while (s >= 0 && s < res_k) {
+        const int block = s >> macro.shift;
+        const int block_end = up ? std::min(res_k - 1, ((block + 1) << macro.shift) - 1) : block << macro.shift;
+        int first[2], last[2];
+        std::uint32_t in_slice;
+        const bool full = rectangle(std::min(s, block_end), std::max(s, block_end) + 1, first, last, in_slice) && any_macrocell(macro, k, block, first, last);
+        if (!full) {
+            if (stop_before(up ? block_end + 1 : block_end)) return true;
+            s = block_end + step;
+            continue;
+        }
+        for (;; s += step) {
+            if (!rectangle(s, s + 1, first, last, in_slice)) first[1] = last[1] + 1;
+            const int cells = (last[0] - first[0] + 1) * std::max(0, last[1] - first[1] + 1);
+            if (cells > kMaxCellsPerLane * lane_count) {
+                for (std::uint32_t bits = walking; bits; bits &= bits - 1) {
+                    const int q = std::countr_zero(bits);
+                    lanes.entry[q] = vmax(lanes.entry[q], plane_t(q, up ? s : s + 1));
+                }
+                for (int q = 0; q < n; ++q)
+                    if (!((walking >> q) & 1u)) lanes.active[q] = lanes.active[q] & !lanes.active[q];
+                return false;
+            }
+            const std::uint32_t* row = begin + s * stride[k] + first[1] * stride[v] + first[0] * stride[u];
+            bool packet_cells = false;
+            for (int j = first[1]; j <= last[1]; ++j, row += stride[v]) {
+                const std::uint32_t* cell = row;
+                for (int i = first[0]; i <= last[0]; ++i, cell += stride[u]) {
+                    if (cell[0] == cell[1]) continue;
+                    if (!packet_cells) {
+                        for (std::uint32_t bits = in_slice; bits; bits &= bits - 1) {
+                            const int q = std::countr_zero(bits);
+                            for (int x = 0; x < 2; ++x)
+                                cell_span(lane_min<K>(packet_lo[q][x]), lane_max<K>(packet_hi[q][x]),
+                                          g.bounds.lo[axes[x]], g.inv_cell_size[axes[x]], g.res[axes[x]],
+                                          packet_first[q][x], packet_last[q][x]);
+                        }
+                        packet_cells = true;
+                    }
+                    std::uint32_t here = 0;
+                    for (std::uint32_t bits = in_slice; bits; bits &= bits - 1) {
+                        const int q = std::countr_zero(bits);
+                        if (packet_first[q][0] <= i && i <= packet_last[q][0] && packet_first[q][1] <= j &&
+                            j <= packet_last[q][1])
+                            here |= 1u << q;
+                    }
+                    if (visit_cell(std::uint32_t(cell - begin), here, walking)) return true;
+                }
+            }
+            if (stop_before(up ? s + 1 : s)) return true;
+            if (s == block_end) break;
+        }
+        s = block_end + step;
+    }
+    return true;
+}
+
+/// walk_group() testing each cell's primitives against the packets in the
+/// slice, each primitive once per packet. AnyHit: lanes that hit are added
+/// to their packet's `occluded` and stop.
+template <int K, int G, bool AnyHit>
+bool trace_group(const Grid& grid, const PacketRecordIntersector<vfloat<K>>& isect, int k,
+                 GroupLanes<K, G>& lanes) {
+    GroupMailbox mailbox;
+    const std::uint32_t* begin = grid.cell_begin.data();
+    const std::uint32_t* refs = grid.refs.data();
+    return walk_group<K, G>(grid, k, lanes, [&](std::uint32_t c, std::uint32_t in_slice, std::uint32_t& walking)
+                                                RAYPACK_INLINE_LAMBDA {
+        for (std::uint32_t r = begin[c], r_end = begin[c + 1]; r < r_end; ++r) {
+            const std::uint32_t prim = refs[r];
+            std::uint32_t& tested = mailbox.tested(prim);
+            const std::uint32_t todo = in_slice & walking & ~tested;
+            tested |= todo;
+            for (std::uint32_t bits = todo; bits; bits &= bits - 1) {
+                const int q = std::countr_zero(bits);
+                LoadedPacket<K>& p = *lanes.packet[q];
+                const vmask<K> m = isect.intersect(lanes.active[q], p.ray, p.hit, prim);
+                if constexpr (AnyHit) {
+                    if (any(m)) {
+                        p.occluded = p.occluded | m;
+                        lanes.active[q] = lanes.active[q] & !m;
+                        if (none(lanes.active[q])) {
+                            walking &= ~(1u << q);
+                            if (walking == 0) return true;
+                        }
+                    }
+                }
+            }
+        }
+        return false;
+    });
+}
+
+}  // namespace raypack::coherent_grid
