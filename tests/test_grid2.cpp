@@ -141,6 +141,8 @@ TEST_F(Grid2, TheTreeNoLongerCrowdsIntoAFewCells) {
     classic.large_primitives_outside = false;
     const GridAccel grid(scene, AccelConfig{}, classic);
     const Grid2Accel grid2(scene, AccelConfig{});
+    // Its ground and trunk stay outside the cells, as in the uniform grid.
+    EXPECT_EQ(grid2.grid().top.outside, (std::vector<std::uint32_t>{0, 1, 2}));
     GridRayCounters one, two;
     const std::vector<Rayf> rays = camera_rays(scene, 48);
     for (const Rayf& r : rays) {

@@ -16,15 +16,21 @@
 // in the group's rectangle of that slice, and the lane's packet is tested
 // against everything in it.
 //
-// Included only by grid_packet.cpp.
+// Included only by grid_packet.cpp and grid2_accel.cpp.
 #include <bit>
 #include <cstdint>
 #include <limits>
 
 #include "accel/grid/coherent_grid.h"
+#include "accel/grid/grid_lanes_walk.h"
 #include "accel/packet_driver.h"
 
 namespace raypack::coherent_grid {
+
+/// Rays per group of coherent packets: 128 rays (8 packets of 16, two 8 x 8
+/// tiles of `raypack rays`) traced camera and shadow rays as fast as 256 and
+/// up to 1.08x as fast as 64 (docs/structures.md).
+inline constexpr int kGroupRays = 128;
 
 /// Per-primitive record of the packets of a group already tested against
 /// it (direct-mapped; a collision forgets, which only repeats a test).
@@ -51,6 +57,20 @@ struct GroupLanes {
     vfloat<K> entry[G];
     int count = 0;
 };
+
+/// The packets of p[0, count) that meet the grid's box, with their lanes
+/// that do and where they enter it.
+template <int K, int G, SlabMethod Slabs>
+RAYPACK_INLINE void enter_group(const Grid& grid, LoadedPacket<K>* p, int count, GroupLanes<K, G>& lanes) {
+    for (int q = 0; q < count; ++q) {
+        vfloat<K> entry;
+        const vmask<K> active = grid_lanes::enter_grid<K, Slabs>(grid, p[q].ray, p[q].valid, entry);
+        if (none(active)) continue;
+        lanes.packet[lanes.count] = &p[q];
+        lanes.active[lanes.count] = active;
+        lanes.entry[lanes.count++] = entry;
+    }
+}
 
 /// The major axis every active lane of the group travels along in one
 /// direction (that of the first packet's first lane), or -1.

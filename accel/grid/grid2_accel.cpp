@@ -8,9 +8,12 @@
 #include "accel/cell_accel_impl.h"
 #include "accel/cell_kernel_variants.h"
 #include "accel/grid/coherent_grid.h"
+#include "accel/grid/coherent_grid_group.h"
 #include "accel/grid/dda.h"
+#include "accel/grid/grid_build.h"
 #include "accel/grid/grid_lanes_walk.h"
 #include "accel/grid/grid_packet.h"
+#include "accel/grid/outside_prims.h"
 #include "accel/packet_driver.h"
 #include "accel/packet_widths.h"
 
@@ -21,7 +24,10 @@ Grid2Accel::Grid2Accel(const Scene& scene, const AccelConfig& config, const TwoL
     const std::size_t n = scene.primitive_count();
     std::vector<Box3f> boxes(n);
     tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) { boxes[i] = primitive_bounds(scene, std::uint32_t(i)); });
+    std::vector<std::uint32_t> outside = large_primitives(boxes);
+    for (std::uint32_t p : outside) boxes[p] = Box3f{};  // an empty box: in no cell
     grid_ = build_two_level_grid(boxes, PrimitiveBoxOverlap{&scene}, grid_config);
+    grid_.top.outside = std::move(outside);
     packets_exact_ = grid_packets_exact(grid_.top) &&
                      std::all_of(grid_.cells.begin(), grid_.cells.end(), [](const Grid& g) { return grid_packets_exact(g); });
     std::size_t references = 0, empty = 0, cells = 0;
@@ -69,16 +75,17 @@ struct Mailbox {
 template <bool AnyHit, bool Counting, SlabMethod Slabs>
 bool Grid2Accel::walk(Rayf& ray, Hitf& hit, GridRayCounters* counters) const {
     if constexpr (Counting) ++counters->rays;
-    if (grid_.empty()) return false;
+    const PrimitiveIntersector<float> isect{scene_, kernels_, triangle_edges()};
+    const Grid& top = grid_.top;
+    bool found = intersect_outside<AnyHit>(top, isect, ray, hit, Counting ? &counters->prim_tests : nullptr);
+    if (AnyHit && found) return true;
+    if (grid_.empty()) return found;
     const Vec3f inv_dir = ray_reciprocal(ray.dir, kernels_.rcp);
     float entry;
     const SlabRay<float> slab = make_slab_ray(ray.org, inv_dir, ray.tnear, ray.tfar);
-    const Grid& top = grid_.top;
-    if (!intersect_box<Slabs, float>(true, slab, top.geometry.bounds.lo, top.geometry.bounds.hi, entry)) return false;
-    const PrimitiveIntersector<float> isect{scene_, kernels_, triangle_edges()};
+    if (!intersect_box<Slabs, float>(true, slab, top.geometry.bounds.lo, top.geometry.bounds.hi, entry)) return found;
     Mailbox mailbox;
     GridDda top_dda(top.geometry, ray.org, ray.dir, inv_dir, entry, SlabTag<Slabs>{});
-    bool found = false;
     while (const std::optional<DdaSegment> cell = top_dda.next()) {
         const std::uint32_t index = grid_.cell_grid[cell->cell];
         if constexpr (Counting) {
@@ -122,51 +129,59 @@ bool Grid2Accel::walk(Rayf& ray, Hitf& hit, GridRayCounters* counters) const {
 }
 
 // Packets whose rays share a major direction walk the top grid slice by
-// slice (coherent_grid.h); in each non-empty top cell the lanes that cross
-// its grid walk that grid the same way (or, if they spread there, each its
-// own DDA). Lanes the top walk gives up on, and packets that are not
-// coherent, finish one ray at a time from where they are.
+// slice (coherent_grid.h), in groups where consecutive packets share it
+// (coherent_grid_group.h); in each non-empty top cell the lanes of a packet
+// that cross its grid walk that grid the same way (or, if they spread there,
+// each its own DDA). Lanes the top walk gives up on, and packets that are
+// not coherent, finish one ray at a time from where they are.
+template <int K, bool AnyHit, SlabMethod Slabs>
+bool Grid2Accel::visit_top_cell(const PacketRecordIntersector<vfloat<K>>& isect, int k, std::uint32_t c, RayPacket<K>& ray,
+                                HitPacket<K>& hit, vmask<K>& active, const vfloat<K>& entry,
+                                vmask<K>& occluded) const {
+    using F = vfloat<K>;
+    const Grid& sub = grid_.cells[grid_.cell_grid[c]];
+    if (sub.empty()) return false;
+    if (sub.geometry.cells() == 1) {
+        // A grid of one cell: its primitives against the active lanes, no walk.
+        for (const std::uint32_t prim : sub.refs) {
+            const vmask<K> m = isect.intersect(active, ray, hit, prim);
+            if constexpr (AnyHit) {
+                occluded = occluded | m;
+                active = active & !m;
+                if (none(active)) return true;
+            }
+        }
+        return false;
+    }
+    const SlabRay<F> slab = make_slab_ray(ray.org, ray.rdir, entry, ray.tfar);
+    F sub_entry;
+    vmask<K> sub_active = intersect_box<Slabs, F>(active, slab, splat<F>(sub.geometry.bounds.lo),
+                                                  splat<F>(sub.geometry.bounds.hi), sub_entry);
+    if (none(sub_active)) return false;
+    if (!coherent_grid::trace<K, AnyHit>(sub, isect, k, ray, hit, sub_active, sub_entry, occluded))
+        grid_lanes::dda_walk<K, AnyHit, Slabs>(sub, isect, ray, hit, sub_active, sub_entry, occluded);
+    if constexpr (AnyHit) {
+        active = active & !occluded;
+        return none(active);
+    }
+    return false;
+}
+
 template <int K, bool AnyHit, SlabMethod Slabs>
 void Grid2Accel::trace_packet(const PacketRecordIntersector<vfloat<K>>& isect, RayPacket<K>& ray,
-                              HitPacket<K>& hit, vmask<K> valid, vmask<K>& occluded) const {
-    using F = vfloat<K>;
-    F entry;
-    vmask<K> active = grid_lanes::enter_grid<K, Slabs>(grid_.top, ray, valid, entry);
-    if (none(active)) return;
+                              HitPacket<K>& hit, vmask<K> active, vfloat<K> entry, vmask<K>& occluded) const {
     const int k = coherent_grid::major_axis<K>(ray, active);
-    if (k >= 0) {
-        auto visit_top_cell = [&](std::uint32_t c) RAYPACK_INLINE_LAMBDA {
-            const Grid& sub = grid_.cells[grid_.cell_grid[c]];
-            if (sub.empty()) return false;
-            if (sub.geometry.cells() == 1) {
-                // A grid of one cell: its primitives against the active lanes, no walk.
-                for (const std::uint32_t prim : sub.refs) {
-                    const vmask<K> m = isect.intersect(active, ray, hit, prim);
-                    if constexpr (AnyHit) {
-                        occluded = occluded | m;
-                        active = active & !m;
-                        if (none(active)) return true;
-                    }
-                }
-                return false;
-            }
-            const SlabRay<F> slab = make_slab_ray(ray.org, ray.rdir, entry, ray.tfar);
-            F sub_entry;
-            vmask<K> sub_active = intersect_box<Slabs, F>(active, slab, splat<F>(sub.geometry.bounds.lo),
-                                                          splat<F>(sub.geometry.bounds.hi), sub_entry);
-            if (none(sub_active)) return false;
-            if (!coherent_grid::trace<K, AnyHit>(sub, isect, k, ray, hit, sub_active, sub_entry, occluded))
-                grid_lanes::dda_walk<K, AnyHit, Slabs>(sub, isect, ray, hit, sub_active, sub_entry, occluded);
-            if constexpr (AnyHit) {
-                active = active & !occluded;
-                return none(active);
-            }
-            return false;
-        };
-        if (coherent_grid::walk<K>(grid_.top, k, ray, active, entry, visit_top_cell)) return;
-    }
-    // The lanes left, alone: each from where the walk left it, up to its
-    // closest hit so far (everything before was tested).
+    if (k >= 0 && coherent_grid::walk<K>(grid_.top, k, ray, active, entry, [&](std::uint32_t c) RAYPACK_INLINE_LAMBDA {
+            return visit_top_cell<K, AnyHit, Slabs>(isect, k, c, ray, hit, active, entry, occluded);
+        }))
+        return;
+    finish_alone<K, AnyHit, Slabs>(ray, hit, active, entry, occluded);
+}
+
+template <int K, bool AnyHit, SlabMethod Slabs>
+void Grid2Accel::finish_alone(RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> active, const vfloat<K>& entry,
+                              vmask<K>& occluded) const {
+    using F = vfloat<K>;
     alignas(64) float org[3][K], dir[3][K], start[K], tfar[K], t[K], u[K], v[K];
     for (int a = 0; a < 3; ++a) ray.org[a].store_aligned(org[a]), ray.dir[a].store_aligned(dir[a]);
     entry.store_aligned(start), ray.tfar.store_aligned(tfar);
@@ -199,17 +214,51 @@ void Grid2Accel::trace_packet(const PacketRecordIntersector<vfloat<K>>& isect, R
 template <bool AnyHit>
 void Grid2Accel::trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
     with_packet_width(width, "grid2", [&]<int K>() {
-        const PacketRecordIntersector<vfloat<K>> isect{scene_, kernels_, triangle_edges()};
+        using F = vfloat<K>;
+        const PacketRecordIntersector<F> isect{scene_, kernels_, triangle_edges()};
         with_slab_form(kernels_.slabs, [&]<SlabMethod Slabs>(SlabTag<Slabs>) {
-            trace_in_packets<K, AnyHit>(rays, hits, kernels_.rcp,
-                                        [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid, vmask<K>& occluded) {
-                                            if (grid_.empty()) return;
-                                            trace_packet<K, AnyHit, Slabs>(isect, ray, hit, valid, occluded);
-                                        });
+            auto trace_one = [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid, vmask<K>& occluded) {
+                intersect_outside<K, AnyHit>(grid_.top, isect, ray, hit, valid, occluded);
+                if (grid_.empty()) return;
+                F entry;
+                const vmask<K> active = grid_lanes::enter_grid<K, Slabs>(grid_.top, ray, valid, entry);
+                if (any(active)) trace_packet<K, AnyHit, Slabs>(isect, ray, hit, active, entry, occluded);
+            };
+            constexpr int G = coherent_grid::kGroupRays / K;
+            trace_in_groups_or_alone<K, G, AnyHit>(
+                rays, hits, kernels_.rcp, [](const LoadedPacket<K>&) { return true; }, trace_one,
+                [&](LoadedPacket<K>* p, int count) {
+                    for (int q = 0; q < count; ++q)
+                        intersect_outside<K, AnyHit>(grid_.top, isect, p[q].ray, p[q].hit, p[q].valid, p[q].occluded);
+                    if (grid_.empty()) return true;
+                    coherent_grid::GroupLanes<K, G> lanes;
+                    coherent_grid::enter_group<K, G, Slabs>(grid_.top, p, count, lanes);
+                    const int k = lanes.count > 1 ? coherent_grid::group_major_axis<K, G>(lanes) : -1;
+                    if (k >= 0 && coherent_grid::walk_group<K, G>(
+                                      grid_.top, k, lanes,
+                                      [&](std::uint32_t c, std::uint32_t here, std::uint32_t& walking) {
+                                          for (std::uint32_t bits = here & walking; bits; bits &= bits - 1) {
+                                              const int q = std::countr_zero(bits);
+                                              LoadedPacket<K>& one = *lanes.packet[q];
+                                              if (visit_top_cell<K, AnyHit, Slabs>(isect, k, c, one.ray, one.hit,
+                                                                                   lanes.active[q], lanes.entry[q],
+                                                                                   one.occluded))
+                                                  walking &= ~(1u << q);
+                                          }
+                                          return walking == 0;
+                                      }))
+                        return true;
+                    for (int q = 0; q < lanes.count; ++q) {
+                        LoadedPacket<K>& one = *lanes.packet[q];
+                        if (any(lanes.active[q]))
+                            trace_packet<K, AnyHit, Slabs>(isect, one.ray, one.hit, lanes.active[q], lanes.entry[q],
+                                                           one.occluded);
+                    }
+                    return true;
+                });
         });
     });
 }
-
 
 template class CellAccel<Grid2Accel, GridRayCounters>;
 

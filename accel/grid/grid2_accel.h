@@ -2,7 +2,8 @@
 // Two-level grid (`--accel grid2`, two_level_grid.h): single rays walk the
 // top grid's cells with a 3D-DDA and, in each non-empty cell, that cell's
 // own grid over the same stretch of the ray; coherent packets walk both
-// levels slice by slice (coherent_grid.h).
+// levels slice by slice (coherent_grid.h), the top one in groups of 128 rays
+// (coherent_grid_group.h).
 #include <cstdint>
 
 #include "accel/cell_accel.h"
@@ -22,9 +23,19 @@ private:
     friend class CellAccel<Grid2Accel, GridRayCounters>;
     template <bool AnyHit>
     void trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const;
+    /// The lanes `active` of a packet from `entry` (inside the top grid's box).
     template <int K, bool AnyHit, SlabMethod Slabs>
     void trace_packet(const PacketRecordIntersector<vfloat<K>>& isect, RayPacket<K>& ray, HitPacket<K>& hit,
-                      vmask<K> valid, vmask<K>& occluded) const;
+                      vmask<K> active, vfloat<K> entry, vmask<K>& occluded) const;
+    /// Top cell c's grid against the lanes `active`, which all travel one
+    /// way along axis k; true once none is left.
+    template <int K, bool AnyHit, SlabMethod Slabs>
+    bool visit_top_cell(const PacketRecordIntersector<vfloat<K>>& isect, int k, std::uint32_t c, RayPacket<K>& ray,
+                        HitPacket<K>& hit, vmask<K>& active, const vfloat<K>& entry, vmask<K>& occluded) const;
+    /// The lanes `active`, one ray at a time, from `entry` up to their closest hits so far.
+    template <int K, bool AnyHit, SlabMethod Slabs>
+    void finish_alone(RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> active, const vfloat<K>& entry,
+                      vmask<K>& occluded) const;
     template <bool AnyHit, bool Counting, SlabMethod Slabs>
     bool walk(Rayf& ray, Hitf& hit, GridRayCounters* counters) const;
     bool packets_exact() const { return packets_exact_; }

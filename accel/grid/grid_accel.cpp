@@ -12,6 +12,7 @@
 #include "accel/grid/dda.h"
 #include "accel/grid/grid_build.h"
 #include "accel/grid/grid_packet.h"
+#include "accel/grid/outside_prims.h"
 
 namespace raypack {
 
@@ -65,15 +66,8 @@ template <bool AnyHit, bool Counting, bool Mailbox, SlabMethod Slabs>
 bool GridAccel::trace(Rayf& ray, Hitf& hit, GridRayCounters* counters) const {
     if constexpr (Counting) ++counters->rays;
     const PrimitiveIntersector<float> isect{scene_, kernels_, triangle_edges()};
-    bool found = false;
-    // The primitives outside the cells first: a hit there shortens the walk.
-    for (const std::uint32_t prim : grid_.outside) {
-        if constexpr (Counting) ++counters->prim_tests;
-        if (isect.intersect(prim, ray, hit)) {
-            found = true;
-            if constexpr (AnyHit) return true;
-        }
-    }
+    bool found = intersect_outside<AnyHit>(grid_, isect, ray, hit, Counting ? &counters->prim_tests : nullptr);
+    if (AnyHit && found) return true;
     if (grid_.empty()) return found;
     const Vec3f inv_dir = ray_reciprocal(ray.dir, kernels_.rcp);
     float entry;

@@ -7,6 +7,7 @@
 #include "accel/grid/coherent_grid.h"
 #include "accel/grid/coherent_grid_group.h"
 #include "accel/grid/grid_lanes_walk.h"
+#include "accel/grid/outside_prims.h"
 #include "accel/packet_driver.h"
 #include "accel/packet_intersector.h"
 #include "kernels/aabb.h"
@@ -19,12 +20,6 @@ bool grid_packets_exact(const Grid& grid) {
         if (r >= (1 << 24)) return false;
     return true;
 }
-
-/// Rays per group of coherent packets (coherent_grid_group.h): 128 rays
-/// (8 packets of 16, two 8 x 8 tiles of `raypack rays`) traced camera and
-/// shadow rays as fast as 256 and up to 1.08x as fast as 64
-/// (docs/structures.md).
-constexpr int kGridGroupRays = 128;
 
 template <int K, bool AnyHit>
 void grid_trace_packets(const Grid& grid, const Scene& scene, KernelChoice kernels,
@@ -45,18 +40,8 @@ void grid_trace_packets(const Grid& grid, const Scene& scene, KernelChoice kerne
             }
             grid_lanes::dda_walk<K, AnyHit, Slabs>(grid, isect, ray, hit, active, entry, occluded);
         };
-        // The primitives outside the cells, before the walk (their hits shorten it).
-        auto test_outside = [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K>& valid, vmask<K>& occluded) {
-            for (const std::uint32_t prim : grid.outside) {
-                const vmask<K> m = isect.intersect(valid, ray, hit, prim);
-                if constexpr (AnyHit) {
-                    occluded = occluded | m;
-                    valid = valid & !m;
-                }
-            }
-        };
         auto trace_one = [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid, vmask<K>& occluded) {
-            test_outside(ray, hit, valid, occluded);
+            intersect_outside<K, AnyHit>(grid, isect, ray, hit, valid, occluded);
             if (grid.empty()) return;
             vfloat<K> entry;
             const vmask<K> active = grid_lanes::enter_grid<K, Slabs>(grid, ray, valid, entry);
@@ -66,23 +51,16 @@ void grid_trace_packets(const Grid& grid, const Scene& scene, KernelChoice kerne
             trace_in_packets<K, AnyHit>(rays, hits, kernels.rcp, trace_one);
             return;
         }
-        constexpr int G = kGridGroupRays / K;
+        constexpr int G = coherent_grid::kGroupRays / K;
         static_assert(G >= 2 && G <= 32, "a group's packets are bits of a 32-bit word");
         trace_in_groups_or_alone<K, G, AnyHit>(
             rays, hits, kernels.rcp, [](const LoadedPacket<K>&) { return true; }, trace_one,
             [&](LoadedPacket<K>* p, int count) {
-                for (int q = 0; q < count; ++q) test_outside(p[q].ray, p[q].hit, p[q].valid, p[q].occluded);
+                for (int q = 0; q < count; ++q)
+                    intersect_outside<K, AnyHit>(grid, isect, p[q].ray, p[q].hit, p[q].valid, p[q].occluded);
                 if (grid.empty()) return true;
                 coherent_grid::GroupLanes<K, G> lanes;
-                for (int q = 0; q < count; ++q) {
-                    vfloat<K> entry;
-                    const vmask<K> active = grid_lanes::enter_grid<K, Slabs>(grid, p[q].ray, p[q].valid, entry);
-                    if (none(active)) continue;
-                    lanes.packet[lanes.count] = &p[q];
-                    lanes.active[lanes.count] = active;
-                    lanes.entry[lanes.count++] = entry;
-                }
-                if (lanes.count == 0) return true;
+                coherent_grid::enter_group<K, G, Slabs>(grid, p, count, lanes);
                 const int k = lanes.count > 1 ? coherent_grid::group_major_axis<K, G>(lanes) : -1;
                 if (k >= 0 && coherent_grid::trace_group<K, G, AnyHit>(grid, isect, k, lanes)) return true;
                 for (int q = 0; q < lanes.count; ++q) {
