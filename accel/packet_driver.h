@@ -94,6 +94,18 @@ RAYPACK_INLINE void load_fresh_packet(std::span<const Rayf> rays, std::size_t fi
     p.occluded = p.valid & !p.valid;
 }
 
+/// Whether the valid lanes of a packet leave one point (pinhole camera rays,
+/// rays from one light): groups of such packets bound their rays tightly.
+template <int K>
+RAYPACK_INLINE bool one_origin(const LoadedPacket<K>& p) {
+    const std::uint32_t bits = mask_bits(p.valid);
+    if (!bits) return false;
+    const int first = std::countr_zero(bits);
+    for (int a = 0; a < 3; ++a)
+        if (mask_bits(p.ray.org[a] != vfloat<K>(lane(p.ray.org[a], first))) & bits) return false;
+    return true;
+}
+
 /// `trace_packet(ray, hit, valid, occluded)` traces one packet: it records
 /// closest hits in `hit`, or sets the `occluded` lanes for any-hit queries.
 /// `rcp` computes the packets' reciprocal directions (`--rcp`).

@@ -34,6 +34,7 @@
 #include "accel/grid/dda_packet.h"
 #include "accel/grid/grid_accel.h"
 #include "accel/grid/grid_build.h"
+#include "accel/outside_prims.h"
 #include "accel/grid/grid_packet.h"
 #include "accel/grid/triangle_box_overlap.h"
 #include "render/camera_rays.h"

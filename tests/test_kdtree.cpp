@@ -105,7 +105,7 @@ void expect_well_formed(const KdTreeAccel& accel, const Scene& scene) {
     EXPECT_EQ(depth, accel.stats().depth);
     EXPECT_EQ(accel.stats().nodes, t.nodes.size());
     EXPECT_EQ(accel.stats().leaves, leaves);
-    EXPECT_EQ(accel.stats().bytes, t.nodes.size() * 8 + t.prim_index.size() * 4);
+    EXPECT_EQ(accel.stats().bytes, t.nodes.size() * 8 + (t.prim_index.size() + t.outside.size()) * 4);
 }
 
 // ---- Every shared scene -------------------------------------------------------------
@@ -180,6 +180,15 @@ TEST_P(KdTree, PacketGroupsGiveThePacketsAnswers) {
 INSTANTIATE_TEST_SUITE_P(, KdTree, ::testing::ValuesIn(shared_scene_files()), param_name);
 
 // ---- Hand-made scenes -----------------------------------------------------------------
+
+TEST_F(KdTree, TheGroundStaysOutsideTheTree) {
+    // SPD balls: the ground (its two triangles, 24 units across) is tested
+    // by every ray, and the root voxel fits the sphereflake (under 2 units).
+    const Scene scene = load_scene(std::string(RAYPACK_SOURCE_DIR) + "/scenes/balls.nff");
+    const KdTreeAccel kd(scene, AccelConfig{});
+    EXPECT_EQ(kd.tree().outside, (std::vector<std::uint32_t>{0, 1}));
+    EXPECT_LT(kd.tree().bounds.extent().x, 2.0f);
+}
 
 TEST_F(KdTree, SameTreeForAnyThreadCount) {
     // Subtrees of more than 4096 primitives near the root are built in

@@ -176,9 +176,11 @@ const std::vector<std::string> kScenes = {"balls.nff", "mount.nff", "rings.nff",
 /// lose none: their builders widen cells and nodes by a placement margin that
 /// also covers plain rounding. The k-d tree's plain walk drops the margin of
 /// its split planes, so rays in and along them miss leaves (Ize 2013's case).
+/// (tree lost 24 until its ground left the tree, session 30: the rays along
+/// the ground's plane meet it outside the tree now.)
 const std::map<std::string, std::array<std::size_t, 3>> kPlainAdversarialLosses = {
     {"balls.nff", {0, 0, 0}},    {"mount.nff", {0, 0, 22}},  {"rings.nff", {0, 0, 15}},
-    {"teapot.nff", {0, 0, 10}}, {"tetra.nff", {0, 0, 238}}, {"tree.nff", {0, 0, 24}},
+    {"teapot.nff", {0, 0, 10}}, {"tetra.nff", {0, 0, 238}}, {"tree.nff", {0, 0, 0}},
 };
 
 class KernelVariantsCells : public ::testing::TestWithParam<std::string> {};

@@ -155,7 +155,7 @@ void expect_well_formed(const OctreeAccel& accel, const Scene& scene, const Octr
     EXPECT_EQ(s.leaves, leaves);
     EXPECT_EQ(s.depth, depth);
     EXPECT_EQ(accel.empty_leaves(), empty);
-    EXPECT_EQ(s.bytes, t.nodes.size() * 8 + t.refs.size() * 4 + accel.triangle_edge_bytes());
+    EXPECT_EQ(s.bytes, t.nodes.size() * 8 + (t.refs.size() + t.outside.size()) * 4 + accel.triangle_edge_bytes());
     EXPECT_GE(s.build_ms, 0.0);
     if (scene.primitive_count()) {
         EXPECT_GE(accel.references_per_primitive(), 1.0);
@@ -219,6 +219,15 @@ TEST_P(Octree, PacketGroupsGiveThePacketsAnswers) {
 INSTANTIATE_TEST_SUITE_P(, Octree, ::testing::ValuesIn(shared_scene_files()), param_name);
 
 // ---- Hand-made scenes -----------------------------------------------------------------
+
+TEST_F(Octree, TheGroundStaysOutsideTheTree) {
+    // SPD balls: the ground (its two triangles, 24 units across) is tested
+    // by every ray, and the cube fits the sphereflake (under 2 units).
+    const Scene scene = load_scene(std::string(RAYPACK_SOURCE_DIR) + "/scenes/balls.nff");
+    const auto octree = make_octree(scene);
+    EXPECT_EQ(octree->octree().outside, (std::vector<std::uint32_t>{0, 1}));
+    EXPECT_LT(octree->octree().cube.extent().x, 2.0f);
+}
 
 TEST_F(Octree, StateTableIsThePapers) {
     // new_node: from child c, leaving through axis k's plane, moves to c | bit

@@ -45,7 +45,7 @@ struct GridConfig {
     /// A few primitives far larger than the rest (a ground polygon under a
     /// small object: SPD balls, rings, tree) are tested by every ray instead
     /// of being placed in cells, so that the grid's box, and with it the
-    /// cells, fit the rest (large_primitives() in grid_build.h).
+    /// cells, fit the rest (accel/outside_prims.h).
     bool large_primitives_outside = true;
     /// Cells are widened by at least this much when primitives are placed
     /// (grid_build.h); a sub-grid of a two-level grid takes its parent's.

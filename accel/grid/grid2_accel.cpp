@@ -7,13 +7,12 @@
 
 #include "accel/cell_accel_impl.h"
 #include "accel/cell_kernel_variants.h"
+#include "accel/outside_prims.h"
 #include "accel/grid/coherent_grid.h"
 #include "accel/grid/coherent_grid_group.h"
 #include "accel/grid/dda.h"
-#include "accel/grid/grid_build.h"
 #include "accel/grid/grid_lanes_walk.h"
 #include "accel/grid/grid_packet.h"
-#include "accel/grid/outside_prims.h"
 #include "accel/packet_driver.h"
 #include "accel/packet_widths.h"
 
@@ -24,8 +23,7 @@ Grid2Accel::Grid2Accel(const Scene& scene, const AccelConfig& config, const TwoL
     const std::size_t n = scene.primitive_count();
     std::vector<Box3f> boxes(n);
     tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) { boxes[i] = primitive_bounds(scene, std::uint32_t(i)); });
-    std::vector<std::uint32_t> outside = large_primitives(boxes);
-    for (std::uint32_t p : outside) boxes[p] = Box3f{};  // an empty box: in no cell
+    std::vector<std::uint32_t> outside = take_large_primitives(boxes);
     grid_ = build_two_level_grid(boxes, PrimitiveBoxOverlap{&scene}, grid_config);
     grid_.top.outside = std::move(outside);
     packets_exact_ = grid_packets_exact(grid_.top) &&
@@ -77,7 +75,7 @@ bool Grid2Accel::walk(Rayf& ray, Hitf& hit, GridRayCounters* counters) const {
     if constexpr (Counting) ++counters->rays;
     const PrimitiveIntersector<float> isect{scene_, kernels_, triangle_edges()};
     const Grid& top = grid_.top;
-    bool found = intersect_outside<AnyHit>(top, isect, ray, hit, Counting ? &counters->prim_tests : nullptr);
+    bool found = intersect_outside<AnyHit>(top.outside, isect, ray, hit, Counting ? &counters->prim_tests : nullptr);
     if (AnyHit && found) return true;
     if (grid_.empty()) return found;
     const Vec3f inv_dir = ray_reciprocal(ray.dir, kernels_.rcp);
@@ -218,7 +216,7 @@ void Grid2Accel::trace_packets(int width, std::span<const Rayf> rays, std::span<
         const PacketRecordIntersector<F> isect{scene_, kernels_, triangle_edges()};
         with_slab_form(kernels_.slabs, [&]<SlabMethod Slabs>(SlabTag<Slabs>) {
             auto trace_one = [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid, vmask<K>& occluded) {
-                intersect_outside<K, AnyHit>(grid_.top, isect, ray, hit, valid, occluded);
+                intersect_outside<K, AnyHit>(grid_.top.outside, isect, ray, hit, valid, occluded);
                 if (grid_.empty()) return;
                 F entry;
                 const vmask<K> active = grid_lanes::enter_grid<K, Slabs>(grid_.top, ray, valid, entry);
@@ -229,7 +227,7 @@ void Grid2Accel::trace_packets(int width, std::span<const Rayf> rays, std::span<
                 rays, hits, kernels_.rcp, [](const LoadedPacket<K>&) { return true; }, trace_one,
                 [&](LoadedPacket<K>* p, int count) {
                     for (int q = 0; q < count; ++q)
-                        intersect_outside<K, AnyHit>(grid_.top, isect, p[q].ray, p[q].hit, p[q].valid, p[q].occluded);
+                        intersect_outside<K, AnyHit>(grid_.top.outside, isect, p[q].ray, p[q].hit, p[q].valid, p[q].occluded);
                     if (grid_.empty()) return true;
                     coherent_grid::GroupLanes<K, G> lanes;
                     coherent_grid::enter_group<K, G, Slabs>(grid_.top, p, count, lanes);

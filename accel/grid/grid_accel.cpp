@@ -8,11 +8,11 @@
 #include <vector>
 
 #include "accel/cell_kernel_variants.h"
+#include "accel/outside_prims.h"
 #include "accel/cell_accel_impl.h"
 #include "accel/grid/dda.h"
 #include "accel/grid/grid_build.h"
 #include "accel/grid/grid_packet.h"
-#include "accel/grid/outside_prims.h"
 
 namespace raypack {
 
@@ -25,10 +25,7 @@ GridAccel::GridAccel(const Scene& scene, const AccelConfig& config, const GridCo
     std::vector<Box3f> boxes(n);
     tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) { boxes[i] = primitive_bounds(scene, std::uint32_t(i)); });
     std::vector<std::uint32_t> outside;
-    if (grid_config.large_primitives_outside) {
-        outside = large_primitives(boxes);
-        for (std::uint32_t p : outside) boxes[p] = Box3f{};  // an empty box: in no cell
-    }
+    if (grid_config.large_primitives_outside) outside = take_large_primitives(boxes);
     const PrimitiveBoxOverlap exact{&scene};
     grid_ = build_grid(boxes, grid_config.exact_overlap ? &exact : nullptr, grid_config);
     grid_.outside = std::move(outside);
@@ -66,7 +63,7 @@ template <bool AnyHit, bool Counting, bool Mailbox, SlabMethod Slabs>
 bool GridAccel::trace(Rayf& ray, Hitf& hit, GridRayCounters* counters) const {
     if constexpr (Counting) ++counters->rays;
     const PrimitiveIntersector<float> isect{scene_, kernels_, triangle_edges()};
-    bool found = intersect_outside<AnyHit>(grid_, isect, ray, hit, Counting ? &counters->prim_tests : nullptr);
+    bool found = intersect_outside<AnyHit>(grid_.outside, isect, ray, hit, Counting ? &counters->prim_tests : nullptr);
     if (AnyHit && found) return true;
     if (grid_.empty()) return found;
     const Vec3f inv_dir = ray_reciprocal(ray.dir, kernels_.rcp);

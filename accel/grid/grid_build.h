@@ -3,9 +3,7 @@
 // references into cells (count pass, prefix sum, fill pass), as in Kalojanov
 // & Slusallek, "A Parallel Algorithm for Construction of Uniform Grids", HPG
 // 2009, and Lagae & Dutre 2008.
-#include <cstdint>
 #include <span>
-#include <vector>
 
 #include "accel/grid/grid.h"
 #include "accel/grid/primitive_box_overlap.h"
@@ -19,17 +17,6 @@ namespace raypack {
 /// cell is found in that cell. Primitives with a non-finite or empty box are
 /// left out.
 Grid build_grid(std::span<const Box3f> boxes, const PrimitiveBoxOverlap* exact, const GridConfig& config);
-
-/// The primitives to keep out of the cells (at most kMaxOutside): the
-/// smallest number m of the largest boxes (by surface area) whose removal
-/// shrinks the box of the others to within 4/5 of the most that removing up
-/// to kMaxOutside of them could, if that shrinks the box's area at least
-/// kMinShrink-fold; none otherwise, or for fewer than kMinPrimitives
-/// primitives. Unusable boxes (non-finite, empty) never count.
-inline constexpr std::size_t kMaxOutside = 8;
-inline constexpr float kMinShrink = 4.0f;
-inline constexpr std::size_t kMinPrimitives = 32;
-std::vector<std::uint32_t> large_primitives(std::span<const Box3f> boxes);
 
 /// grid.macro from grid's cells (its shift as set).
 void build_macrocells(Grid& grid);

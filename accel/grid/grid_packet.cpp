@@ -4,10 +4,10 @@
 #include <limits>
 
 #include "accel/cell_kernel_variants.h"
+#include "accel/outside_prims.h"
 #include "accel/grid/coherent_grid.h"
 #include "accel/grid/coherent_grid_group.h"
 #include "accel/grid/grid_lanes_walk.h"
-#include "accel/grid/outside_prims.h"
 #include "accel/packet_driver.h"
 #include "accel/packet_intersector.h"
 #include "kernels/aabb.h"
@@ -41,7 +41,7 @@ void grid_trace_packets(const Grid& grid, const Scene& scene, KernelChoice kerne
             grid_lanes::dda_walk<K, AnyHit, Slabs>(grid, isect, ray, hit, active, entry, occluded);
         };
         auto trace_one = [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid, vmask<K>& occluded) {
-            intersect_outside<K, AnyHit>(grid, isect, ray, hit, valid, occluded);
+            intersect_outside<K, AnyHit>(grid.outside, isect, ray, hit, valid, occluded);
             if (grid.empty()) return;
             vfloat<K> entry;
             const vmask<K> active = grid_lanes::enter_grid<K, Slabs>(grid, ray, valid, entry);
@@ -57,7 +57,7 @@ void grid_trace_packets(const Grid& grid, const Scene& scene, KernelChoice kerne
             rays, hits, kernels.rcp, [](const LoadedPacket<K>&) { return true; }, trace_one,
             [&](LoadedPacket<K>* p, int count) {
                 for (int q = 0; q < count; ++q)
-                    intersect_outside<K, AnyHit>(grid, isect, p[q].ray, p[q].hit, p[q].valid, p[q].occluded);
+                    intersect_outside<K, AnyHit>(grid.outside, isect, p[q].ray, p[q].hit, p[q].valid, p[q].occluded);
                 if (grid.empty()) return true;
                 coherent_grid::GroupLanes<K, G> lanes;
                 coherent_grid::enter_group<K, G, Slabs>(grid, p, count, lanes);

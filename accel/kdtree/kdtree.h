@@ -76,8 +76,13 @@ struct KdTree {
     std::size_t references = 0;  ///< primitive references over all leaves
     double sah_cost = 0;         ///< expected cost of a random ray, in traversal-cost units
 
-    bool empty() const { return nodes.empty(); }
-    std::size_t bytes() const { return nodes.size() * sizeof(KdNode) + prim_index.size() * sizeof(std::uint32_t); }
+    /// Primitives in no leaf, tested by every ray first (accel/outside_prims.h).
+    std::vector<std::uint32_t> outside;
+
+    bool empty() const { return nodes.empty(); }  ///< no leaf holds anything (`outside` may)
+    std::size_t bytes() const {
+        return nodes.size() * sizeof(KdNode) + (prim_index.size() + outside.size()) * sizeof(std::uint32_t);
+    }
     /// Primitives of leaf `n`.
     const std::uint32_t* leaf_prims(const KdNode& n) const {
         return n.prim_count() == 1 ? &n.word : prim_index.data() + n.word;

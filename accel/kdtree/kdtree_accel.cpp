@@ -10,6 +10,7 @@
 #include "accel/cell_accel_impl.h"
 #include "accel/kdtree/kdtree_build.h"
 #include "accel/kdtree/kdtree_packet.h"
+#include "accel/outside_prims.h"
 #include "accel/kdtree/kdtree_ray_interval.h"
 #include "accel/kdtree/primitive_clipper.h"
 
@@ -24,7 +25,9 @@ KdTreeAccel::KdTreeAccel(const Scene& scene, const AccelConfig& config, const Kd
     const KdClipFn clip = [&](std::uint32_t prim, const Box3f& voxel, Box3f& out) {
         return clipper.clip(prim, voxel, out);
     };
+    std::vector<std::uint32_t> outside = take_large_primitives(boxes);
     tree_ = build_kdtree(boxes, clip, kd_config);
+    tree_.outside = std::move(outside);
     stats_.name = "kdtree";
     stats_.builder = "sah-nlogn";
     stats_.nodes = tree_.nodes.size();
@@ -81,17 +84,19 @@ inline void count_empty_leaf(KdRayCounters* counters, bool visited) {
 template <bool AnyHit, bool Counting, SlabMethod Slabs>
 bool KdTreeAccel::walk(Rayf& ray, Hitf& hit, KdRayCounters* counters) const {
     if constexpr (Counting) ++counters->rays;
-    if (tree_.empty()) return false;
+    const PrimitiveIntersector<float> isect{scene_, kernels_};
+    bool found = intersect_outside<AnyHit>(tree_.outside, isect, ray, hit, Counting ? &counters->prim_tests : nullptr);
+    if (AnyHit && found) return true;
+    if (tree_.empty()) return found;
     const Vec3f rdir = ray_reciprocal(ray.dir, kernels_.rcp);
     float tmin, tmax;
     if (!ray_box_interval<float, Slabs>(true, ray.org, rdir, ray.tnear, ray.tfar, tree_.bounds, tree_.margin, tmin,
                                        tmax))
-        return false;
+        return found;
     constexpr bool plain = Slabs == SlabMethod::Plain;
     const Vec3f org_rdir{ray.org.x * rdir.x, ray.org.y * rdir.y, ray.org.z * rdir.z};
     const float margin = plain ? 0.0f : tree_.margin;
     const float slack[3] = {margin * std::fabs(rdir.x), margin * std::fabs(rdir.y), margin * std::fabs(rdir.z)};
-    const PrimitiveIntersector<float> isect{scene_, kernels_};
     const bool double_ties = kernels_.precision == Precision::Double;
     const KdNode* nodes = tree_.nodes.data();
     struct PendingNode {
@@ -101,7 +106,6 @@ bool KdTreeAccel::walk(Rayf& ray, Hitf& hit, KdRayCounters* counters) const {
     PendingNode stack[kKdMaxDepth + 1];
     int sp = 0;
     std::uint32_t current = 0;
-    bool found = false;
     for (;;) {
         const KdNode node = nodes[current];
         if constexpr (Counting) ++counters->nodes_visited;

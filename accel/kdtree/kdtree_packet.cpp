@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "accel/kdtree/kdtree_ray_interval.h"
+#include "accel/outside_prims.h"
 #include "accel/packet_driver.h"
 #include "accel/packet_intersector.h"
 #include "accel/packet_mailbox.h"
@@ -49,11 +50,7 @@ RAYPACK_INLINE bool one_octant(const Vec3<vfloat<K>>& rdir, std::uint32_t bits) 
 template <int K>
 RAYPACK_INLINE bool may_lead_group(const LoadedPacket<K>& p) {
     const std::uint32_t bits = mask_bits(p.valid);
-    if (!bits || !one_octant<K>(p.ray.rdir, bits)) return false;
-    const int first = std::countr_zero(bits);
-    for (int a = 0; a < 3; ++a)
-        if (mask_bits(p.ray.org[a] != vfloat<K>(lane(p.ray.org[a], first))) & bits) return false;
-    return true;
+    return bits && one_octant<K>(p.ray.rdir, bits) && one_origin<K>(p);
 }
 
 /// The primitives of leaf `node` against the lanes `active` (closest hits,
@@ -487,7 +484,8 @@ void kdtree_trace_packets(const KdTree& tree, const Scene& scene, KernelChoice k
     const PacketPrimitiveIntersector<F> isect{&scene, kernels};
     // The slab form is chosen once for all packets, rdir once per packet.
     with_slab_form(kernels.slabs, [&]<SlabMethod Slabs>(SlabTag<Slabs>) {
-        const auto trace_one = [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid, vmask<K>& occluded) {
+        // The primitives outside the leaves first: their hits shorten the walk.
+        const auto walk_one = [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid, vmask<K>& occluded) {
             if (tree.empty()) return;
             vfloat<K> tmin, tmax;
             const vmask<K> in_box = ray_box_interval<vfloat<K>, Slabs>(valid, ray.org, ray.rdir, ray.tnear, ray.tfar,
@@ -499,6 +497,10 @@ void kdtree_trace_packets(const KdTree& tree, const Scene& scene, KernelChoice k
             else
                 trace_packet<K, AnyHit, Slabs, false>(tree, isect, ray, hit, valid, occluded, in_box, tmin, tmax);
         };
+        const auto trace_one = [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid, vmask<K>& occluded) {
+            intersect_outside<K, AnyHit>(tree.outside, isect, ray, hit, valid, occluded);
+            walk_one(ray, hit, valid, occluded);
+        };
         // Rays from one point (pinhole camera rays) walk in groups; the
         // walk's bounds need robust slabs and float tests (trace_group).
 #if defined(__AVX2__)
@@ -507,7 +509,14 @@ void kdtree_trace_packets(const KdTree& tree, const Scene& scene, KernelChoice k
                 constexpr int G = kKdGroupPackets;
                 trace_in_groups_or_alone<K, G, AnyHit>(
                     rays, hits, kernels.rcp, [](const LoadedPacket<K>& p) { return may_lead_group<K>(p); }, trace_one,
-                    [&](LoadedPacket<K>* p, int count) { return trace_group<K, G, AnyHit>(tree, isect, p, count); });
+                    [&](LoadedPacket<K>* p, int count) {
+                        for (int q = 0; q < count; ++q)
+                            intersect_outside<K, AnyHit>(tree.outside, isect, p[q].ray, p[q].hit, p[q].valid,
+                                                         p[q].occluded);
+                        if (trace_group<K, G, AnyHit>(tree, isect, p, count)) return true;
+                        for (int q = 0; q < count; ++q) walk_one(p[q].ray, p[q].hit, p[q].valid, p[q].occluded);
+                        return true;
+                    });
                 return;
             }
         }

@@ -53,9 +53,13 @@ struct Octree {
     std::vector<std::uint32_t> refs;   ///< primitive numbers, ascending within each leaf
     float margin = 0;                  ///< boxes were widened by this for placement
     int depth = 0;                     ///< deepest leaf
+    /// Primitives in no leaf, tested by every ray first (accel/outside_prims.h).
+    std::vector<std::uint32_t> outside;
 
-    bool empty() const { return nodes.empty(); }
-    std::size_t bytes() const { return nodes.size() * sizeof(OctreeNode) + refs.size() * sizeof(std::uint32_t); }
+    bool empty() const { return nodes.empty(); }  ///< no leaf holds anything (`outside` may)
+    std::size_t bytes() const {
+        return nodes.size() * sizeof(OctreeNode) + (refs.size() + outside.size()) * sizeof(std::uint32_t);
+    }
 };
 
 }  // namespace raypack

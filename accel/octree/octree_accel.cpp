@@ -10,6 +10,7 @@
 #include "accel/octree/octree_build.h"
 #include "accel/octree/octree_packet.h"
 #include "accel/octree/revelles.h"
+#include "accel/outside_prims.h"
 
 namespace raypack {
 
@@ -18,8 +19,10 @@ OctreeAccel::OctreeAccel(const Scene& scene, const AccelConfig& config, const Oc
     const std::size_t n = scene.primitive_count();
     std::vector<Box3f> boxes(n);
     tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) { boxes[i] = primitive_bounds(scene, std::uint32_t(i)); });
+    std::vector<std::uint32_t> outside = take_large_primitives(boxes);
     const PrimitiveBoxOverlap exact{&scene};
     tree_ = build_octree(boxes, octree_config.exact_overlap ? &exact : nullptr, octree_config);
+    tree_.outside = std::move(outside);
     std::size_t leaves = 0;
     for (const OctreeNode& node : tree_.nodes) {
         leaves += node.is_leaf();
@@ -63,7 +66,10 @@ struct Frame {
 template <bool AnyHit, bool Counting, SlabMethod Slabs>
 bool OctreeAccel::walk(Rayf& ray, Hitf& hit, OctreeRayCounters* counters) const {
     if constexpr (Counting) ++counters->rays;
-    if (tree_.empty()) return false;
+    const PrimitiveIntersector<float> isect{scene_, kernels_, triangle_edges()};
+    bool found = intersect_outside<AnyHit>(tree_.outside, isect, ray, hit, Counting ? &counters->prim_tests : nullptr);
+    if (AnyHit && found) return true;
+    if (tree_.empty()) return found;
     const Vec3f rdir = ray_reciprocal(ray.dir, kernels_.rcp);
     const Box3f& cube = tree_.cube;
     unsigned a = 0;
@@ -80,13 +86,11 @@ bool OctreeAccel::walk(Rayf& ray, Hitf& hit, OctreeRayCounters* counters) const 
         f.tm[k] = 0.5f * (f.t0[k] + f.t1[k]);
     }
     const float enter = std::max({f.t0[0], f.t0[1], f.t0[2]}), exit = std::min({f.t1[0], f.t1[1], f.t1[2]});
-    if (!(std::max(enter, ray.tnear) <= std::min(exit, ray.tfar))) return false;
+    if (!(std::max(enter, ray.tnear) <= std::min(exit, ray.tfar))) return found;
 
-    const PrimitiveIntersector<float> isect{scene_, kernels_, triangle_edges()};
     const bool float_ties = kernels_.precision == Precision::Float;
     const OctreeNode* nodes = tree_.nodes.data();
     const std::uint32_t* refs = tree_.refs.data();
-    bool found = false;
     // The primitives of a leaf; true if the walk may stop (any hit found).
     auto test_leaf = [&](const OctreeNode& leaf) {
         if constexpr (Counting) ++counters->leaves_visited;

@@ -145,10 +145,21 @@ Box3f octree_cube(const Box3f& bounds, float margin) {
         cube.lo[a] = std::min(c[a] - half, bounds.lo[a] - 2.0f * margin);
         cube.hi[a] = std::max(c[a] + half, bounds.hi[a] + 2.0f * margin);
     }
-    // Rounding of the centre can leave the sides a few ulps apart: equalise them.
+    // Rounding of the centre can leave the sides a few ulps apart: equalise
+    // them. lo + side itself rounds, and not every side is hi - lo for some
+    // float hi, so raise the side an ulp at a time until it is for all three.
+    const Vec3f top = cube.hi;
     float side = 0;
     for (int a = 0; a < 3; ++a) side = std::max(side, cube.hi[a] - cube.lo[a]);
-    for (int a = 0; a < 3; ++a) cube.hi[a] = std::max(cube.hi[a], cube.lo[a] + side);
+    for (int round = 0; round < 64; ++round) {
+        bool equal = true;
+        for (int a = 0; a < 3; ++a) {
+            cube.hi[a] = std::max(top[a], cube.lo[a] + side);
+            equal = equal && cube.hi[a] - cube.lo[a] == side;
+        }
+        if (equal) break;
+        side = std::nextafter(side, std::numeric_limits<float>::infinity());
+    }
     return cube;
 }
 

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "accel/cell_kernel_variants.h"
+#include "accel/outside_prims.h"
 #include "accel/ray_box_interval.h"
 #include "accel/packet_driver.h"
 #include "accel/packet_intersector.h"
@@ -412,24 +413,38 @@ void octree_trace_packets(const Octree& tree, const Scene& scene, KernelChoice k
                           const TriangleEdgeRecord* triangle_edges, std::span<const Rayf> rays,
                           std::span<Hitf> hits, bool groups) {
     using F = vfloat<K>;
-    if (tree.empty()) {
+    if (tree.empty() && tree.outside.empty()) {
         for (auto& h : hits) h = Hitf{};
         return;
     }
     const PacketRecordIntersector<F> isect{&scene, kernels, triangle_edges};
     // The slab form is chosen once for all packets, rdir once per packet.
     with_slab_form(kernels.slabs, [&]<SlabMethod Slabs>(SlabTag<Slabs>) {
+        // The primitives outside the leaves first: their hits shorten the walk.
+        const auto walk_one = [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid, vmask<K>& occluded) {
+            if (!tree.empty()) trace_packet<K, AnyHit, Slabs>(tree, isect, ray, hit, valid, occluded);
+        };
         const auto trace_one = [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid, vmask<K>& occluded) {
-            trace_packet<K, AnyHit, Slabs>(tree, isect, ray, hit, valid, occluded);
+            intersect_outside<K, AnyHit>(tree.outside, isect, ray, hit, valid, occluded);
+            walk_one(ray, hit, valid, occluded);
         };
 #if defined(__AVX2__)
         static_assert(kOctreeGroupPackets == 8, "trace_group: one lane of a vfloat<8> per packet");
-        // Packets of one direction octant walk in groups (trace_group); the
-        // tie rule needs float tests (the double ones go lane by lane).
+        // Packets from one point and of one direction octant walk in groups
+        // (trace_group); packets of spread origins (shadow rays from a tile's
+        // surface points) ran 1.2-2.3x faster alone on tetra, teapot and
+        // gears. The tie rule needs float tests (the double ones go lane by lane).
         if (groups && kernels.precision == Precision::Float) {
             trace_in_groups_or_alone<K, kOctreeGroupPackets, AnyHit>(
-                rays, hits, kernels.rcp, [](const LoadedPacket<K>& p) { return packet_octant<K>(p) >= 0; }, trace_one,
-                [&](LoadedPacket<K>* p, int count) { return trace_group<K, AnyHit, Slabs>(tree, isect, p, count); });
+                rays, hits, kernels.rcp,
+                [](const LoadedPacket<K>& p) { return packet_octant<K>(p) >= 0 && one_origin<K>(p); }, trace_one,
+                [&](LoadedPacket<K>* p, int count) {
+                    for (int q = 0; q < count; ++q)
+                        intersect_outside<K, AnyHit>(tree.outside, isect, p[q].ray, p[q].hit, p[q].valid, p[q].occluded);
+                    if (tree.empty() || trace_group<K, AnyHit, Slabs>(tree, isect, p, count)) return true;
+                    for (int q = 0; q < count; ++q) walk_one(p[q].ray, p[q].hit, p[q].valid, p[q].occluded);
+                    return true;
+                });
             return;
         }
 #else
