@@ -829,7 +829,8 @@ TEST_F(Grid, LargePrimitivesStayOutsideTheCells) {
         EXPECT_TRUE(classic->grid().outside.empty());
         GridRayCounters fitted_counts, classic_counts;
         for (const Rayf& r : camera_rays(scene, 64)) {
-            const Hitf a = grid->intersect_counting(r, fitted_counts), b = classic->intersect_counting(r, classic_counts);
+            const Hitf a = grid->intersect_counting(r, fitted_counts);
+            const Hitf b = classic->intersect_counting(r, classic_counts);
             EXPECT_EQ(a.prim, b.prim) << file;
             EXPECT_EQ(a.t, b.t) << file;
         }

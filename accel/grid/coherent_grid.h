@@ -177,7 +177,8 @@ bool walk(const Grid& grid, int k, const RayPacket<K>& ray, vmask<K>& active, vf
         const int block = s >> macro.shift;
         const int block_end = up ? std::min(res_k - 1, ((block + 1) << macro.shift) - 1) : block << macro.shift;
         int first[2], last[2];
-        const bool full = rectangle(std::min(s, block_end), std::max(s, block_end) + 1, first, last) && any_macrocell(macro, k, block, first, last);
+        const bool full = rectangle(std::min(s, block_end), std::max(s, block_end) + 1, first, last) &&
+                          any_macrocell(macro, k, block, first, last);
         if (!full) {
             if (stop_before(up ? block_end + 1 : block_end)) return true;
             s = block_end + step;

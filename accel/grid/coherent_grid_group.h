@@ -9,9 +9,10 @@
 // a slice spans about a cell along a diagonal. A group visits the union of
 // its packets' rectangles once.
 //
-// Each primitive of a cell is tested against the packets that have a lane
-// in the slice at hand (the others cannot cross the cell there), once per
-// packet: the mailbox keeps, per primitive, the packets already tested.
+// Each primitive of a cell is tested against the packets whose own
+// rectangle in the slice holds the cell (the others cannot cross it there),
+// once per packet: the mailbox keeps, per primitive, the packets already
+// tested.
 // Exactness is coherent_grid.h's: every cell a lane's segment crosses lies
 // in the group's rectangle of that slice, and the lane's packet is tested
 // against everything in it.
@@ -90,9 +91,10 @@ int group_major_axis(const GroupLanes<K, G>& lanes) {
 }
 
 /// walk() for a group: the major axis k and its sign are shared by every
-/// active lane of every packet (the caller checks). `visit_cell(c, in_slice)`
-/// tests cell c against the packets of the bit set `in_slice` and returns
-/// true once no lane is left. Returns true when the group is done; false
+/// active lane of every packet (the caller checks). `visit_cell(c, packets,
+/// walking)` tests cell c against the packets of the bit set `packets`
+/// (those whose own rectangle in the slice holds the cell), clears in
+/// `walking` the packets left without lanes, and returns true once none is. Returns true when the group is done; false
 /// when its rays spread too far apart, with each packet's active lanes and
 /// entries set for it to go on alone.
 template <int K, int G, class VisitCell>
@@ -210,7 +212,8 @@ bool walk_group(const Grid& grid, int k, GroupLanes<K, G>& lanes, VisitCell&& vi
         const int block_end = up ? std::min(res_k - 1, ((block + 1) << macro.shift) - 1) : block << macro.shift;
         int first[2], last[2];
         std::uint32_t in_slice;
-        const bool full = rectangle(std::min(s, block_end), std::max(s, block_end) + 1, first, last, in_slice) && any_macrocell(macro, k, block, first, last);
+        const bool full = rectangle(std::min(s, block_end), std::max(s, block_end) + 1, first, last, in_slice) &&
+                          any_macrocell(macro, k, block, first, last);
         if (!full) {
             if (stop_before(up ? block_end + 1 : block_end)) return true;
             s = block_end + step;
@@ -262,8 +265,8 @@ bool walk_group(const Grid& grid, int k, GroupLanes<K, G>& lanes, VisitCell&& vi
     return true;
 }
 
-/// walk_group() testing each cell's primitives against the packets in the
-/// slice, each primitive once per packet. AnyHit: lanes that hit are added
+/// walk_group() testing each cell's primitives against the packets whose
+/// rectangle holds the cell, each primitive once per packet. AnyHit: lanes that hit are added
 /// to their packet's `occluded` and stop.
 template <int K, int G, bool AnyHit>
 bool trace_group(const Grid& grid, const PacketRecordIntersector<vfloat<K>>& isect, int k,
@@ -271,12 +274,12 @@ bool trace_group(const Grid& grid, const PacketRecordIntersector<vfloat<K>>& ise
     GroupMailbox mailbox;
     const std::uint32_t* begin = grid.cell_begin.data();
     const std::uint32_t* refs = grid.refs.data();
-    return walk_group<K, G>(grid, k, lanes, [&](std::uint32_t c, std::uint32_t in_slice, std::uint32_t& walking)
+    return walk_group<K, G>(grid, k, lanes, [&](std::uint32_t c, std::uint32_t packets, std::uint32_t& walking)
                                                 RAYPACK_INLINE_LAMBDA {
         for (std::uint32_t r = begin[c], r_end = begin[c + 1]; r < r_end; ++r) {
             const std::uint32_t prim = refs[r];
             std::uint32_t& tested = mailbox.tested(prim);
-            const std::uint32_t todo = in_slice & walking & ~tested;
+            const std::uint32_t todo = packets & walking & ~tested;
             tested |= todo;
             for (std::uint32_t bits = todo; bits; bits &= bits - 1) {
                 const int q = std::countr_zero(bits);

@@ -7,12 +7,12 @@
 
 #include "accel/cell_accel_impl.h"
 #include "accel/cell_kernel_variants.h"
-#include "accel/outside_prims.h"
 #include "accel/grid/coherent_grid.h"
 #include "accel/grid/coherent_grid_group.h"
 #include "accel/grid/dda.h"
 #include "accel/grid/grid_lanes_walk.h"
 #include "accel/grid/grid_packet.h"
+#include "accel/outside_prims.h"
 #include "accel/packet_driver.h"
 #include "accel/packet_widths.h"
 
@@ -133,8 +133,8 @@ bool Grid2Accel::walk(Rayf& ray, Hitf& hit, GridRayCounters* counters) const {
 // each its own DDA). Lanes the top walk gives up on, and packets that are
 // not coherent, finish one ray at a time from where they are.
 template <int K, bool AnyHit, SlabMethod Slabs>
-bool Grid2Accel::visit_top_cell(const PacketRecordIntersector<vfloat<K>>& isect, int k, std::uint32_t c, RayPacket<K>& ray,
-                                HitPacket<K>& hit, vmask<K>& active, const vfloat<K>& entry,
+bool Grid2Accel::visit_top_cell(const PacketRecordIntersector<vfloat<K>>& isect, int k, std::uint32_t c,
+                                RayPacket<K>& ray, HitPacket<K>& hit, vmask<K>& active, const vfloat<K>& entry,
                                 vmask<K>& occluded) const {
     using F = vfloat<K>;
     const Grid& sub = grid_.cells[grid_.cell_grid[c]];
@@ -227,7 +227,8 @@ void Grid2Accel::trace_packets(int width, std::span<const Rayf> rays, std::span<
                 rays, hits, kernels_.rcp, [](const LoadedPacket<K>&) { return true; }, trace_one,
                 [&](LoadedPacket<K>* p, int count) {
                     for (int q = 0; q < count; ++q)
-                        intersect_outside<K, AnyHit>(grid_.top.outside, isect, p[q].ray, p[q].hit, p[q].valid, p[q].occluded);
+                        intersect_outside<K, AnyHit>(grid_.top.outside, isect, p[q].ray, p[q].hit, p[q].valid,
+                                                     p[q].occluded);
                     if (grid_.empty()) return true;
                     coherent_grid::GroupLanes<K, G> lanes;
                     coherent_grid::enter_group<K, G, Slabs>(grid_.top, p, count, lanes);

@@ -7,12 +7,12 @@
 #include <string>
 #include <vector>
 
-#include "accel/cell_kernel_variants.h"
-#include "accel/outside_prims.h"
 #include "accel/cell_accel_impl.h"
+#include "accel/cell_kernel_variants.h"
 #include "accel/grid/dda.h"
 #include "accel/grid/grid_build.h"
 #include "accel/grid/grid_packet.h"
+#include "accel/outside_prims.h"
 
 namespace raypack {
 

@@ -4,10 +4,10 @@
 #include <limits>
 
 #include "accel/cell_kernel_variants.h"
-#include "accel/outside_prims.h"
 #include "accel/grid/coherent_grid.h"
 #include "accel/grid/coherent_grid_group.h"
 #include "accel/grid/grid_lanes_walk.h"
+#include "accel/outside_prims.h"
 #include "accel/packet_driver.h"
 #include "accel/packet_intersector.h"
 #include "kernels/aabb.h"
@@ -65,7 +65,8 @@ void grid_trace_packets(const Grid& grid, const Scene& scene, KernelChoice kerne
                 if (k >= 0 && coherent_grid::trace_group<K, G, AnyHit>(grid, isect, k, lanes)) return true;
                 for (int q = 0; q < lanes.count; ++q) {
                     LoadedPacket<K>& one = *lanes.packet[q];
-                    if (any(lanes.active[q])) go_on_alone(one.ray, one.hit, lanes.active[q], lanes.entry[q], one.occluded);
+                    if (any(lanes.active[q]))
+                        go_on_alone(one.ray, one.hit, lanes.active[q], lanes.entry[q], one.occluded);
                 }
                 return true;
             });

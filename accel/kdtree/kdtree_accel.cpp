@@ -10,9 +10,9 @@
 #include "accel/cell_accel_impl.h"
 #include "accel/kdtree/kdtree_build.h"
 #include "accel/kdtree/kdtree_packet.h"
-#include "accel/outside_prims.h"
 #include "accel/kdtree/kdtree_ray_interval.h"
 #include "accel/kdtree/primitive_clipper.h"
+#include "accel/outside_prims.h"
 
 namespace raypack {
 

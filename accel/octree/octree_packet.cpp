@@ -440,7 +440,8 @@ void octree_trace_packets(const Octree& tree, const Scene& scene, KernelChoice k
                 [](const LoadedPacket<K>& p) { return packet_octant<K>(p) >= 0 && one_origin<K>(p); }, trace_one,
                 [&](LoadedPacket<K>* p, int count) {
                     for (int q = 0; q < count; ++q)
-                        intersect_outside<K, AnyHit>(tree.outside, isect, p[q].ray, p[q].hit, p[q].valid, p[q].occluded);
+                        intersect_outside<K, AnyHit>(tree.outside, isect, p[q].ray, p[q].hit, p[q].valid,
+                                                     p[q].occluded);
                     if (tree.empty() || trace_group<K, AnyHit, Slabs>(tree, isect, p, count)) return true;
                     for (int q = 0; q < count; ++q) walk_one(p[q].ray, p[q].hit, p[q].valid, p[q].occluded);
                     return true;
