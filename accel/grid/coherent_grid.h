@@ -85,6 +85,46 @@ RAYPACK_INLINE bool any_macrocell(const MacroCells& macro, int k, int block, con
 /// 4 and 8 trace camera rays alike; 2 is best for shadow rays.
 inline constexpr int kMaxCellsPerLane = 2;
 
+/// The slice loop of both coherent walks (a packet, walk(); a group,
+/// coherent_grid_group.h), from slice s along axis k, upwards if `up`:
+/// a block of slices (one layer of macrocells) is skipped whole if the
+/// macrocells its rectangle meets are empty; otherwise slice by slice,
+/// `rectangle(i0, i1, first, last)` bounds the cells the lanes cross between
+/// planes i0 and i1 (false: no lane there), `diverged(s, cells)` ends the
+/// walk (false) when the rectangle holds too many cells, `visit_cells(s,
+/// first, last)` visits them (true: no lane left), and `stop_before(i)`
+/// drops the lanes done before plane i (true: none left). Returns true when
+/// the walk is done.
+template <class Rectangle, class Diverged, class VisitCells, class StopBefore>
+RAYPACK_INLINE bool walk_slices(const Grid& grid, int k, bool up, int s, Rectangle&& rectangle, Diverged&& diverged,
+                                VisitCells&& visit_cells, StopBefore&& stop_before) {
+    const MacroCells& macro = grid.macro;
+    const int res_k = grid.geometry.res[k];
+    const int step = up ? 1 : -1;
+    while (s >= 0 && s < res_k) {
+        const int block = s >> macro.shift;
+        const int block_end = up ? std::min(res_k - 1, ((block + 1) << macro.shift) - 1) : block << macro.shift;
+        int first[2], last[2];
+        const bool full = rectangle(std::min(s, block_end), std::max(s, block_end) + 1, first, last) &&
+                          any_macrocell(macro, k, block, first, last);
+        if (!full) {
+            if (stop_before(up ? block_end + 1 : block_end)) return true;
+            s = block_end + step;
+            continue;
+        }
+        for (;; s += step) {
+            if (!rectangle(s, s + 1, first, last)) first[1] = last[1] + 1;  // no lane in this slice: no cells
+            const int cells = (last[0] - first[0] + 1) * std::max(0, last[1] - first[1] + 1);
+            if (diverged(s, cells)) return false;
+            if (visit_cells(s, first, last)) return true;
+            if (stop_before(up ? s + 1 : s)) return true;
+            if (s == block_end) break;
+        }
+        s = block_end + step;
+    }
+    return true;
+}
+
 /// Walks the active lanes through the grid slice by slice along axis k
 /// (from major_axis), from each lane's `entry` distance into the grid's box,
 /// calling `visit_cell(c)` for each non-empty cell c met, which tests what
@@ -118,8 +158,7 @@ bool walk(const Grid& grid, int k, const RayPacket<K>& ray, vmask<K>& active, vf
     const float first_cell = up ? lane_min<K>(select(active, start_cell, inf)) - kCellMargin
                                 : lane_max<K>(select(active, start_cell, -inf)) + kCellMargin;
     const int res_k = g.res[k];
-    int s = first_cell > 0.0f ? (first_cell < float(res_k - 1) ? int(first_cell) : res_k - 1) : 0;
-    const int step = up ? 1 : -1;
+    const int s = first_cell > 0.0f ? (first_cell < float(res_k - 1) ? int(first_cell) : res_k - 1) : 0;
 
     const std::int32_t stride[3] = {1, g.res[0], g.res[0] * g.res[1]};
     const std::uint32_t* begin = grid.cell_begin.data();
@@ -171,38 +210,23 @@ bool walk(const Grid& grid, int k, const RayPacket<K>& ray, vmask<K>& active, vf
         return none(active);
     };
 
-    while (s >= 0 && s < res_k) {
-        // A block of slices (one layer of macrocells): skipped whole if the
-        // macrocells its rectangle meets are empty.
-        const int block = s >> macro.shift;
-        const int block_end = up ? std::min(res_k - 1, ((block + 1) << macro.shift) - 1) : block << macro.shift;
-        int first[2], last[2];
-        const bool full = rectangle(std::min(s, block_end), std::max(s, block_end) + 1, first, last) &&
-                          any_macrocell(macro, k, block, first, last);
-        if (!full) {
-            if (stop_before(up ? block_end + 1 : block_end)) return true;
-            s = block_end + step;
-            continue;
-        }
-        for (;; s += step) {
-            if (!rectangle(s, s + 1, first, last)) first[1] = last[1] + 1;  // no lane in this slice: no cells
-            const int cells = (last[0] - first[0] + 1) * std::max(0, last[1] - first[1] + 1);
-            if (cells > kMaxCellsPerLane * std::popcount(mask_bits(active))) {
-                entry = vmax(entry, plane_t(up ? s : s + 1));
-                return false;
-            }
-            const std::uint32_t* row = begin + s * stride[k] + first[1] * stride[v] + first[0] * stride[u];
+    return walk_slices(
+        grid, k, up, s, rectangle,
+        [&](int slice, int cells) RAYPACK_INLINE_LAMBDA {
+            if (cells <= kMaxCellsPerLane * std::popcount(mask_bits(active))) return false;
+            entry = vmax(entry, plane_t(up ? slice : slice + 1));
+            return true;
+        },
+        [&](int slice, const int first[2], const int last[2]) RAYPACK_INLINE_LAMBDA {
+            const std::uint32_t* row = begin + slice * stride[k] + first[1] * stride[v] + first[0] * stride[u];
             for (int j = first[1]; j <= last[1]; ++j, row += stride[v]) {
                 const std::uint32_t* cell = row;
                 for (int i = first[0]; i <= last[0]; ++i, cell += stride[u])
                     if (cell[0] != cell[1] && visit_cell(std::uint32_t(cell - begin))) return true;
             }
-            if (stop_before(up ? s + 1 : s)) return true;
-            if (s == block_end) break;
-        }
-        s = block_end + step;
-    }
-    return true;
+            return false;
+        },
+        stop_before);
 }
 
 /// walk() testing each cell's primitives against the active lanes, each

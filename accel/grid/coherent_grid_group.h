@@ -150,8 +150,7 @@ bool walk_group(const Grid& grid, int k, GroupLanes<K, G>& lanes, VisitCell&& vi
     }
     first_cell = up ? first_cell - kCellMargin : first_cell + kCellMargin;
     const int res_k = g.res[k];
-    int s = first_cell > 0.0f ? (first_cell < float(res_k - 1) ? int(first_cell) : res_k - 1) : 0;
-    const int step = up ? 1 : -1;
+    const int s = first_cell > 0.0f ? (first_cell < float(res_k - 1) ? int(first_cell) : res_k - 1) : 0;
     const std::int32_t stride[3] = {1, g.res[0], g.res[0] * g.res[1]};
     const std::uint32_t* begin = grid.cell_begin.data();
 
@@ -207,31 +206,24 @@ bool walk_group(const Grid& grid, int k, GroupLanes<K, G>& lanes, VisitCell&& vi
         return walking == 0;
     };
 
-    while (s >= 0 && s < res_k) {
-        const int block = s >> macro.shift;
-        const int block_end = up ? std::min(res_k - 1, ((block + 1) << macro.shift) - 1) : block << macro.shift;
-        int first[2], last[2];
-        std::uint32_t in_slice;
-        const bool full = rectangle(std::min(s, block_end), std::max(s, block_end) + 1, first, last, in_slice) &&
-                          any_macrocell(macro, k, block, first, last);
-        if (!full) {
-            if (stop_before(up ? block_end + 1 : block_end)) return true;
-            s = block_end + step;
-            continue;
-        }
-        for (;; s += step) {
-            if (!rectangle(s, s + 1, first, last, in_slice)) first[1] = last[1] + 1;
-            const int cells = (last[0] - first[0] + 1) * std::max(0, last[1] - first[1] + 1);
-            if (cells > kMaxCellsPerLane * lane_count) {
-                for (std::uint32_t bits = walking; bits; bits &= bits - 1) {
-                    const int q = std::countr_zero(bits);
-                    lanes.entry[q] = vmax(lanes.entry[q], plane_t(q, up ? s : s + 1));
-                }
-                for (int q = 0; q < n; ++q)
-                    if (!((walking >> q) & 1u)) lanes.active[q] = lanes.active[q] & !lanes.active[q];
-                return false;
+    std::uint32_t in_slice = 0;  // the packets with a lane in the slice of the last rectangle
+    return walk_slices(
+        grid, k, up, s,
+        [&](int i0, int i1, int first[2], int last[2]) RAYPACK_INLINE_LAMBDA {
+            return rectangle(i0, i1, first, last, in_slice);
+        },
+        [&](int slice, int cells) RAYPACK_INLINE_LAMBDA {
+            if (cells <= kMaxCellsPerLane * lane_count) return false;
+            for (std::uint32_t bits = walking; bits; bits &= bits - 1) {
+                const int q = std::countr_zero(bits);
+                lanes.entry[q] = vmax(lanes.entry[q], plane_t(q, up ? slice : slice + 1));
             }
-            const std::uint32_t* row = begin + s * stride[k] + first[1] * stride[v] + first[0] * stride[u];
+            for (int q = 0; q < n; ++q)
+                if (!((walking >> q) & 1u)) lanes.active[q] = lanes.active[q] & !lanes.active[q];
+            return true;
+        },
+        [&](int slice, const int first[2], const int last[2]) RAYPACK_INLINE_LAMBDA {
+            const std::uint32_t* row = begin + slice * stride[k] + first[1] * stride[v] + first[0] * stride[u];
             bool packet_cells = false;
             for (int j = first[1]; j <= last[1]; ++j, row += stride[v]) {
                 const std::uint32_t* cell = row;
@@ -257,12 +249,9 @@ bool walk_group(const Grid& grid, int k, GroupLanes<K, G>& lanes, VisitCell&& vi
                     if (visit_cell(std::uint32_t(cell - begin), here, walking)) return true;
                 }
             }
-            if (stop_before(up ? s + 1 : s)) return true;
-            if (s == block_end) break;
-        }
-        s = block_end + step;
-    }
-    return true;
+            return false;
+        },
+        stop_before);
 }
 
 /// walk_group() testing each cell's primitives against the packets whose
