@@ -391,6 +391,58 @@ TEST(BvhBuilders, SpatialSplitsDuplicateReferencesOnSpheres) {
     EXPECT_GT(bvh.prim_index.size(), scene.primitive_count());
 }
 
+bool contains(const Box3f& b, const Vec3f& p) {
+    return p.x >= b.lo.x && p.x <= b.hi.x && p.y >= b.lo.y && p.y <= b.hi.y && p.z >= b.lo.z && p.z <= b.hi.z;
+}
+
+TEST(BvhBuilders, SpatialSplitsCutConesAtTheDiscsThatReachThePlane) {
+    // Random cones (cylinders among them) cut by random planes through their
+    // boxes: every sampled surface point lies in the part of its side, and a
+    // diagonal cylinder cut across its middle keeps about half its box per
+    // side, not the whole box clipped at the plane.
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> coord(-5.0f, 5.0f), radius(0.0f, 1.0f), unit(0.0f, 1.0f);
+    constexpr double kTwoPi = 6.283185307179586;
+    for (int c = 0; c < 400; ++c) {
+        const Vec3f base{coord(rng), coord(rng), coord(rng)};
+        const Vec3f apex = c % 4 == 0 ? base + Vec3f{0, 0, coord(rng)} : Vec3f{coord(rng), coord(rng), coord(rng)};
+        const float rb = radius(rng), ra = c % 3 == 0 ? rb : radius(rng);
+        Scene scene;
+        scene.materials.emplace_back();
+        scene.add_cone(base, rb, apex, ra, 0);
+        const Box3f box = primitive_bounds(scene, 0);
+        const int axis = c % 3;
+        const float position = box.lo[axis] + unit(rng) * (box.hi[axis] - box.lo[axis]);
+        Box3f left, right;
+        split_cone(base, rb, apex, ra, box, axis, position, left, right);
+        // Surface points: an orthonormal frame around the axis, in double.
+        const Vec3f w = normalize(apex - base);
+        const Vec3f t = normalize(std::fabs(w.x) < 0.9f ? cross(w, Vec3f{1, 0, 0}) : cross(w, Vec3f{0, 1, 0}));
+        const Vec3f b = cross(w, t);
+        for (int k = 0; k < 2000; ++k) {
+            const double s = unit(rng), phi = kTwoPi * unit(rng);
+            const double r = rb + s * (double(ra) - rb);
+            Vec3f p;
+            for (int a = 0; a < 3; ++a)
+                p[a] = float(base[a] + s * (double(apex[a]) - base[a]) + r * (std::cos(phi) * t[a] + std::sin(phi) * b[a]));
+            if (!contains(box, p)) continue;  // the point's own rounding
+            if (p[axis] <= position) EXPECT_TRUE(contains(left, p)) << "cone " << c << " point " << k << " left";
+            if (p[axis] >= position) EXPECT_TRUE(contains(right, p)) << "cone " << c << " point " << k << " right";
+        }
+    }
+    const Vec3f base{0, 0, 0}, apex{4, 4, 0};
+    Scene scene;
+    scene.materials.emplace_back();
+    scene.add_cone(base, 0.1f, apex, 0.1f, 0);
+    const Box3f box = primitive_bounds(scene, 0);
+    Box3f left, right;
+    split_cone(base, 0.1f, apex, 0.1f, box, 0, 2.0f, left, right);
+    EXPECT_LT(left.hi.y, 2.2f);   // clipped boxes would reach 4.07
+    EXPECT_GT(right.lo.y, 1.8f);
+    EXPECT_GE(left.hi.x, 2.0f);
+    EXPECT_LE(right.lo.x, 2.0f);
+}
+
 TEST(BvhBuilders, BinnedTreeDoesNotDependOnThreadCount) {
     // The bunny is large enough for parallel binning at the top and parallel subtrees below.
     const Scene& scene = scene_for("bunny.obj");

@@ -89,6 +89,73 @@ void split_sphere(const Vec3f& center, float radius, const Box3f& box, int axis,
 
 }  // namespace
 
+// The surface at axial fraction s lies in the disc of centre
+// c(s) = base + s (apex - base) and radius r(s), linear in s, whose extent along axis a is c_a(s) +- r(s) e_a (e_a = sqrt(1 - w_a^2),
+// w the unit axis). A side holds the discs whose extent reaches across the
+// plane, an interval of s; the union of their boxes is the box of the
+// interval's two end discs (every bound is linear in s). Computed in double
+// and padded as primitive_bounds pads the whole cone's box.
+void split_cone(const Vec3f& base, float base_radius, const Vec3f& apex, float apex_radius, const Box3f& box,
+                int axis, float position, Box3f& left, Box3f& right) {
+    split_box(box, axis, position, left, right);
+    double d[3], e[3];
+    for (int a = 0; a < 3; ++a) d[a] = double(apex[a]) - double(base[a]);
+    const double len2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    if (!(len2 > 0) || !std::isfinite(len2)) return;
+    for (int a = 0; a < 3; ++a) e[a] = std::sqrt(std::max(0.0, 1.0 - d[a] * d[a] / len2)) * 1.0001;
+    const double rb = base_radius, dr = double(apex_radius) - double(base_radius);
+    // lo(s) = base_ax + s d_ax - r(s) e_ax, hi(s) = base_ax + s d_ax + r(s) e_ax.
+    auto reach = [&](double sign, double& at0, double& slope) {
+        at0 = double(base[axis]) + sign * rb * e[axis];
+        slope = d[axis] + sign * dr * e[axis];
+    };
+    // Interval of s in [0, 1] where at0 + slope s <= position (below) or >= it.
+    auto interval = [&](double at0, double slope, bool below, double& s0, double& s1) {
+        s0 = 0, s1 = 1;
+        const double x = double(position) - at0;  // at0 + slope s <= position  <=>  slope s <= x
+        if (slope == 0) {
+            if (below ? 0 > x : 0 < x) s0 = 1, s1 = 0;
+            return;
+        }
+        const double s = x / slope;
+        if ((slope > 0) == below) s1 = std::min(1.0, s);
+        else s0 = std::max(0.0, s);
+    };
+    auto discs_box = [&](double s0, double s1, Box3f& part) {
+        if (part.empty()) return;
+        if (!(s0 <= s1)) {
+            part = Box3f{};
+            return;
+        }
+        s0 = std::max(0.0, s0 - 1e-7), s1 = std::min(1.0, s1 + 1e-7);  // past the rounding of x / slope
+        Box3f b;
+        for (const double s : {s0, s1}) {
+            const double r = rb + s * dr;
+            for (int a = 0; a < 3; ++a) {
+                const double c = double(base[a]) + s * d[a];
+                const double lo = c - r * e[a], hi = c + r * e[a];
+                float flo = float(lo), fhi = float(hi);
+                if (double(flo) > lo) flo = next_down(flo);
+                if (double(fhi) < hi) fhi = next_up(fhi);
+                b.lo[a] = std::min(b.lo[a], flo);
+                b.hi[a] = std::max(b.hi[a], fhi);
+            }
+        }
+        for (int a = 0; a < 3; ++a) {
+            part.lo[a] = std::max(part.lo[a], b.lo[a]);
+            part.hi[a] = std::min(part.hi[a], b.hi[a]);
+        }
+        if (part.empty()) part = Box3f{};
+    };
+    double at0, slope, s0, s1;
+    reach(-1.0, at0, slope);  // a disc reaches left of the plane when its low end does
+    interval(at0, slope, true, s0, s1);
+    discs_box(s0, s1, left);
+    reach(+1.0, at0, slope);
+    interval(at0, slope, false, s0, s1);
+    discs_box(s0, s1, right);
+}
+
 Bvh2 build_scene_bvh2(const Scene& scene, const AccelConfig& config) {
     if (!is_bvh_builder(config.builder)) build_bvh2(config.builder, {}, {});  // throws, naming the builders
     const std::size_t n = scene.primitive_count();
@@ -105,13 +172,18 @@ Bvh2 build_scene_bvh2(const Scene& scene, const AccelConfig& config) {
     bc.reference_budget = config.reference_budget;
     if (config.builder == "sbvh") {
         // Triangles are cut exactly by the split plane (Stich et al. 2009,
-        // sec. 4.3), spheres at the circle the plane cuts; cones clip their boxes.
+        // sec. 4.3), spheres at the circle the plane cuts, cones at the discs that reach
+        // across the plane.
         bc.split_reference = [&scene](std::uint32_t prim, const Box3f& box, int axis, float position, Box3f& left,
                                       Box3f& right) {
             const PrimRef ref = scene.prims[prim];
             if (ref.kind == PrimKind::Sphere)
                 return split_sphere(scene.spheres.center[ref.index], scene.spheres.radius[ref.index], box, axis,
                                     position, left, right);
+            if (ref.kind == PrimKind::Cone)
+                return split_cone(scene.cones.base[ref.index], scene.cones.base_radius[ref.index],
+                                  scene.cones.apex[ref.index], scene.cones.apex_radius[ref.index], box, axis,
+                                  position, left, right);
             if (ref.kind != PrimKind::Triangle) return split_box(box, axis, position, left, right);
             const Vec3f v[3] = {scene.triangles.p0[ref.index], scene.triangles.p1[ref.index],
                                 scene.triangles.p2[ref.index]};
