@@ -3,6 +3,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <bit>
 #include <vector>
 
 #include "accel/cell_accel_impl.h"
@@ -128,9 +129,9 @@ bool Grid2Accel::walk(Rayf& ray, Hitf& hit, GridRayCounters* counters) const {
 
 // Packets whose rays share a major direction walk the top grid slice by
 // slice (coherent_grid.h), in groups where consecutive packets share it
-// (coherent_grid_group.h); in each non-empty top cell the lanes of a packet
-// that cross its grid walk that grid the same way (or, if they spread there,
-// each its own DDA). Lanes the top walk gives up on, and packets that are
+// (coherent_grid_group.h); in each non-empty top cell the lanes that cross
+// its grid walk that grid the same way, a group's packets together (or, if
+// they spread there, each packet alone, and its lanes each their own DDA). Lanes the top walk gives up on, and packets that are
 // not coherent, finish one ray at a time from where they are.
 template <int K, bool AnyHit, SlabMethod Slabs>
 bool Grid2Accel::visit_top_cell(const PacketRecordIntersector<vfloat<K>>& isect, int k, std::uint32_t c,
@@ -163,6 +164,61 @@ bool Grid2Accel::visit_top_cell(const PacketRecordIntersector<vfloat<K>>& isect,
         return none(active);
     }
     return false;
+}
+
+template <int K, int G, bool AnyHit, SlabMethod Slabs>
+bool Grid2Accel::visit_top_cell_group(const PacketRecordIntersector<vfloat<K>>& isect, int k, std::uint32_t c,
+                                      std::uint32_t here, std::uint32_t& walking,
+                                      coherent_grid::GroupLanes<K, G>& lanes) const {
+    using F = vfloat<K>;
+    const Grid& sub = grid_.cells[grid_.cell_grid[c]];
+    here &= walking;
+    if (!sub.empty() && sub.geometry.cells() > 1 && std::popcount(here) > 1) {
+        // The packets' lanes that cross c's grid, where they enter it.
+        coherent_grid::GroupLanes<K, G> inner;
+        int slot[G];
+        for (std::uint32_t bits = here; bits; bits &= bits - 1) {
+            const int q = std::countr_zero(bits);
+            LoadedPacket<K>& one = *lanes.packet[q];
+            const SlabRay<F> slab = make_slab_ray(one.ray.org, one.ray.rdir, lanes.entry[q], one.ray.tfar);
+            F entry;
+            const vmask<K> a = intersect_box<Slabs, F>(lanes.active[q], slab, splat<F>(sub.geometry.bounds.lo),
+                                                       splat<F>(sub.geometry.bounds.hi), entry);
+            if (none(a)) continue;
+            slot[inner.count] = q;
+            inner.packet[inner.count] = &one;
+            inner.active[inner.count] = a;
+            inner.entry[inner.count++] = entry;
+        }
+        if (inner.count > 1 && coherent_grid::group_major_axis<K, G>(inner) == k) {
+            if (!coherent_grid::trace_group<K, G, AnyHit>(sub, isect, k, inner))
+                for (int i = 0; i < inner.count; ++i) {  // spread too far apart: each packet on alone
+                    LoadedPacket<K>& one = *inner.packet[i];
+                    if (any(inner.active[i]) &&
+                        !coherent_grid::trace<K, AnyHit>(sub, isect, k, one.ray, one.hit, inner.active[i],
+                                                         inner.entry[i], one.occluded))
+                        grid_lanes::dda_walk<K, AnyHit, Slabs>(sub, isect, one.ray, one.hit, inner.active[i],
+                                                               inner.entry[i], one.occluded);
+                }
+            if constexpr (AnyHit)
+                for (int i = 0; i < inner.count; ++i) {
+                    const int q = slot[i];
+                    lanes.active[q] = lanes.active[q] & !lanes.packet[q]->occluded;
+                    if (none(lanes.active[q])) walking &= ~(1u << q);
+                }
+            return walking == 0;
+        }
+        here = 0;  // the packets not in `inner` miss c's grid
+        for (int i = 0; i < inner.count; ++i) here |= 1u << slot[i];
+    }
+    for (std::uint32_t bits = here; bits; bits &= bits - 1) {
+        const int q = std::countr_zero(bits);
+        LoadedPacket<K>& one = *lanes.packet[q];
+        if (visit_top_cell<K, AnyHit, Slabs>(isect, k, c, one.ray, one.hit, lanes.active[q], lanes.entry[q],
+                                             one.occluded))
+            walking &= ~(1u << q);
+    }
+    return walking == 0;
 }
 
 template <int K, bool AnyHit, SlabMethod Slabs>
@@ -236,15 +292,8 @@ void Grid2Accel::trace_packets(int width, std::span<const Rayf> rays, std::span<
                     if (k >= 0 && coherent_grid::walk_group<K, G>(
                                       grid_.top, k, lanes,
                                       [&](std::uint32_t c, std::uint32_t here, std::uint32_t& walking) {
-                                          for (std::uint32_t bits = here & walking; bits; bits &= bits - 1) {
-                                              const int q = std::countr_zero(bits);
-                                              LoadedPacket<K>& one = *lanes.packet[q];
-                                              if (visit_top_cell<K, AnyHit, Slabs>(isect, k, c, one.ray, one.hit,
-                                                                                   lanes.active[q], lanes.entry[q],
-                                                                                   one.occluded))
-                                                  walking &= ~(1u << q);
-                                          }
-                                          return walking == 0;
+                                          return visit_top_cell_group<K, G, AnyHit, Slabs>(isect, k, c, here,
+                                                                                           walking, lanes);
                                       }))
                         return true;
                     for (int q = 0; q < lanes.count; ++q) {

@@ -14,6 +14,11 @@
 
 namespace raypack {
 
+namespace coherent_grid {
+template <int K, int G>
+struct GroupLanes;
+}  // namespace coherent_grid
+
 class Grid2Accel final : public CellAccel<Grid2Accel, GridRayCounters> {
 public:
     Grid2Accel(const Scene& scene, const AccelConfig& config, const TwoLevelGridConfig& grid_config = {});
@@ -32,6 +37,12 @@ private:
     template <int K, bool AnyHit, SlabMethod Slabs>
     bool visit_top_cell(const PacketRecordIntersector<vfloat<K>>& isect, int k, std::uint32_t c, RayPacket<K>& ray,
                         HitPacket<K>& hit, vmask<K>& active, const vfloat<K>& entry, vmask<K>& occluded) const;
+    /// visit_top_cell for the packets `here` of a group walking the top grid:
+    /// together through c's grid when they share axis k there; clears in
+    /// `walking` the packets left without lanes and returns true once none is.
+    template <int K, int G, bool AnyHit, SlabMethod Slabs>
+    bool visit_top_cell_group(const PacketRecordIntersector<vfloat<K>>& isect, int k, std::uint32_t c,
+                              std::uint32_t here, std::uint32_t& walking, coherent_grid::GroupLanes<K, G>& lanes) const;
     /// The lanes `active`, one ray at a time, from `entry` up to their closest hits so far.
     template <int K, bool AnyHit, SlabMethod Slabs>
     void finish_alone(RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> active, const vfloat<K>& entry,

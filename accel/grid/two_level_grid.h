@@ -19,12 +19,14 @@
 
 namespace raypack {
 
-/// Densities from raypack's sweep (camera rays of tree, balls and teapot,
-/// top 1/4 to 4 and cells 1 to 24 per primitive; docs/structures.md):
-/// single rays run fastest at 2 and 2, packets at 1/4 to 1 and 2 to 4.
+/// Densities from raypack's sweeps (docs/structures.md): since the large
+/// primitives stay outside and groups walk the cells' grids together
+/// (session 31), a top cell per 4 primitives and 2 cells per primitive below
+/// run every ray kind fastest, single rays and packets, on tree, teapot and
+/// balls (sessions before: single rays at 2 and 2, packets at 1/4 to 1).
 struct TwoLevelGridConfig {
     /// Top cells per primitive.
-    float top_lambda = 1.0f;
+    float top_lambda = 0.25f;
     /// Cells per primitive of each top cell's own grid.
     float cell_lambda = 2.0f;
     /// A top cell with at most this many primitives keeps one cell (a
