@@ -426,8 +426,12 @@ TEST(BvhBuilders, SpatialSplitsCutConesAtTheDiscsThatReachThePlane) {
             for (int a = 0; a < 3; ++a)
                 p[a] = float(base[a] + s * (double(apex[a]) - base[a]) + r * (std::cos(phi) * t[a] + std::sin(phi) * b[a]));
             if (!contains(box, p)) continue;  // the point's own rounding
-            if (p[axis] <= position) EXPECT_TRUE(contains(left, p)) << "cone " << c << " point " << k << " left";
-            if (p[axis] >= position) EXPECT_TRUE(contains(right, p)) << "cone " << c << " point " << k << " right";
+            if (p[axis] <= position) {
+                EXPECT_TRUE(contains(left, p)) << "cone " << c << " point " << k << " left";
+            }
+            if (p[axis] >= position) {
+                EXPECT_TRUE(contains(right, p)) << "cone " << c << " point " << k << " right";
+            }
         }
     }
     const Vec3f base{0, 0, 0}, apex{4, 4, 0};

@@ -117,6 +117,31 @@ bool walk_group(const Grid& grid, int k, GroupLanes<K, G>& lanes, VisitCell&& vi
     float slope_lo[2], slope_hi[2];
     slope_lo[0] = slope_lo[1] = std::numeric_limits<float>::infinity();
     slope_hi[0] = slope_hi[1] = -std::numeric_limits<float>::infinity();
+    // Rays from one point (a pinhole camera's): a packet's lanes cross the
+    // planes of a slice within the lines of its extreme slopes from that
+    // point, so its rectangle there takes a few scalar products, not a
+    // vector pass over its lanes and four reductions.
+    bool one_point = true;
+    float origin[3];
+    float packet_slope_lo[G][2], packet_slope_hi[G][2];
+    auto packet_slopes = [&](int q) RAYPACK_INLINE_LAMBDA {
+        const RayPacket<K>& ray = lanes.packet[q]->ray;
+        const vmask<K> a = lanes.active[q];
+        for (int i = 0; i < 2; ++i) {
+            const F slope = ray.dir[axes[i]] * ray.rdir[k];
+            packet_slope_lo[q][i] = lane_min<K>(select(a, slope, inf));
+            packet_slope_hi[q][i] = lane_max<K>(select(a, slope, -inf));
+        }
+    };
+    for (int q = 0; q < n && one_point; ++q) {
+        const RayPacket<K>& ray = lanes.packet[q]->ray;
+        const vmask<K> a = lanes.active[q];
+        for (int axis = 0; axis < 3; ++axis) {
+            const float o_lo = lane_min<K>(select(a, ray.org[axis], inf));
+            if (q == 0) origin[axis] = o_lo;
+            one_point = one_point && o_lo == origin[axis] && lane_max<K>(select(a, ray.org[axis], -inf)) == o_lo;
+        }
+    }
     for (int q = 0; q < n; ++q) {
         const RayPacket<K>& ray = lanes.packet[q]->ray;
         const vmask<K> a = lanes.active[q];
@@ -131,10 +156,10 @@ bool walk_group(const Grid& grid, int k, GroupLanes<K, G>& lanes, VisitCell&& vi
         const F start = (ray.org[k] + ray.dir[k] * lanes.entry[q] - F(g.bounds.lo[k])) * F(g.inv_cell_size[k]);
         first_cell = up ? std::min(first_cell, lane_min<K>(select(a, start, inf)))
                         : std::max(first_cell, lane_max<K>(select(a, start, -inf)));
+        packet_slopes(q);
         for (int i = 0; i < 2; ++i) {
-            const F slope = ray.dir[axes[i]] * ray.rdir[k];
-            slope_lo[i] = std::min(slope_lo[i], lane_min<K>(select(a, slope, inf)));
-            slope_hi[i] = std::max(slope_hi[i], lane_max<K>(select(a, slope, -inf)));
+            slope_lo[i] = std::min(slope_lo[i], packet_slope_lo[q][i]);
+            slope_hi[i] = std::max(slope_hi[i], packet_slope_hi[q][i]);
         }
         walking |= 1u << q;
         lane_count += std::popcount(mask_bits(a));
@@ -165,7 +190,31 @@ bool walk_group(const Grid& grid, int k, GroupLanes<K, G>& lanes, VisitCell&& vi
     int packet_first[G][2], packet_last[G][2];
     // The union of the packets' rectangles between planes i0 and i1, and the
     // packets that have a lane there.
+    // Between planes at distances d0 and d1 from the point along k, the
+    // lines of slopes [slope_lo, slope_hi] along axis axes[i] (the lines,
+    // not the segments: a superset of every lane's cells).
+    float slice_d0 = 0, slice_d1 = 0;
+    auto point_span = [&](int i, float s_lo, float s_hi, float& lo, float& hi) RAYPACK_INLINE_LAMBDA {
+        const float o = origin[axes[i]];
+        const float c0 = slice_d0 * s_lo, c1 = slice_d0 * s_hi, c2 = slice_d1 * s_lo, c3 = slice_d1 * s_hi;
+        const float a = o + std::min(std::min(c0, c1), std::min(c2, c3));
+        const float b = o + std::max(std::max(c0, c1), std::max(c2, c3));
+        const float slack = (std::fabs(o) + std::fabs(a) + std::fabs(b)) * kRelativeMargin;
+        lo = a - slack, hi = b + slack;
+    };
+    auto rectangle_from_point = [&](int i0, int i1, int first[2], int last[2], std::uint32_t& in_slice)
+                                    RAYPACK_INLINE_LAMBDA {
+        slice_d0 = g.plane(k, i0) - origin[k], slice_d1 = g.plane(k, i1) - origin[k];
+        in_slice = walking;
+        for (int i = 0; i < 2; ++i) {
+            float lo, hi;
+            point_span(i, slope_lo[i], slope_hi[i], lo, hi);
+            cell_span(lo, hi, g.bounds.lo[axes[i]], g.inv_cell_size[axes[i]], g.res[axes[i]], first[i], last[i]);
+        }
+        return walking != 0;
+    };
     auto rectangle = [&](int i0, int i1, int first[2], int last[2], std::uint32_t& in_slice) RAYPACK_INLINE_LAMBDA {
+        if (one_point) return rectangle_from_point(i0, i1, first, last, in_slice);
         F lo[2] = {inf, inf}, hi[2] = {-inf, -inf};
         in_slice = 0;
         for (std::uint32_t bits = walking; bits; bits &= bits - 1) {
@@ -192,16 +241,31 @@ bool walk_group(const Grid& grid, int k, GroupLanes<K, G>& lanes, VisitCell&& vi
                       g.res[axes[i]], first[i], last[i]);
         return true;
     };
+    bool narrowed = false;  // a packet's slopes narrowed since the group's were taken
     auto stop_before = [&](int i) RAYPACK_INLINE_LAMBDA {
         lane_count = 0;
         for (std::uint32_t bits = walking; bits; bits &= bits - 1) {
             const int q = std::countr_zero(bits);
             const F t_out = plane_t(q, i);
             const F end = vmin(lanes.packet[q]->ray.tfar, exit[q]);
-            lanes.active[q] = lanes.active[q] & !(end + (vabs(end) + vabs(t_out)) * rel < t_out);
+            const vmask<K> before = lanes.active[q];
+            lanes.active[q] = before & !(end + (vabs(end) + vabs(t_out)) * rel < t_out);
             const int c = std::popcount(mask_bits(lanes.active[q]));
-            if (c == 0) walking &= ~(1u << q);
+            if (c == 0) walking &= ~(1u << q), narrowed = one_point;
+            else if (one_point && c != std::popcount(mask_bits(before))) packet_slopes(q), narrowed = true;
             lane_count += c;
+        }
+        if (narrowed) {  // the group's slopes, for the rectangles from one point
+            narrowed = false;
+            slope_lo[0] = slope_lo[1] = std::numeric_limits<float>::infinity();
+            slope_hi[0] = slope_hi[1] = -std::numeric_limits<float>::infinity();
+            for (std::uint32_t bits = walking; bits; bits &= bits - 1) {
+                const int q = std::countr_zero(bits);
+                for (int x = 0; x < 2; ++x) {
+                    slope_lo[x] = std::min(slope_lo[x], packet_slope_lo[q][x]);
+                    slope_hi[x] = std::max(slope_hi[x], packet_slope_hi[q][x]);
+                }
+            }
         }
         return walking == 0;
     };
@@ -232,10 +296,17 @@ bool walk_group(const Grid& grid, int k, GroupLanes<K, G>& lanes, VisitCell&& vi
                     if (!packet_cells) {
                         for (std::uint32_t bits = in_slice; bits; bits &= bits - 1) {
                             const int q = std::countr_zero(bits);
-                            for (int x = 0; x < 2; ++x)
-                                cell_span(lane_min<K>(packet_lo[q][x]), lane_max<K>(packet_hi[q][x]),
-                                          g.bounds.lo[axes[x]], g.inv_cell_size[axes[x]], g.res[axes[x]],
+                            for (int x = 0; x < 2; ++x) {
+                                float lo, hi;
+                                if (one_point) {
+                                    point_span(x, packet_slope_lo[q][x], packet_slope_hi[q][x], lo, hi);
+                                } else {
+                                    lo = lane_min<K>(packet_lo[q][x]);
+                                    hi = lane_max<K>(packet_hi[q][x]);
+                                }
+                                cell_span(lo, hi, g.bounds.lo[axes[x]], g.inv_cell_size[axes[x]], g.res[axes[x]],
                                           packet_first[q][x], packet_last[q][x]);
+                            }
                         }
                         packet_cells = true;
                     }
