@@ -289,6 +289,10 @@ bool walk_group(const Grid& grid, int k, GroupLanes<K, G>& lanes, VisitCell&& vi
         [&](int slice, const int first[2], const int last[2]) RAYPACK_INLINE_LAMBDA {
             const std::uint32_t* row = begin + slice * stride[k] + first[1] * stride[v] + first[0] * stride[u];
             bool packet_cells = false;
+            constexpr int kMaxColumns = 64;
+            std::uint32_t in_column[kMaxColumns];
+            std::uint32_t in_row = 0;
+            int row_of_packets = -1;
             for (int j = first[1]; j <= last[1]; ++j, row += stride[v]) {
                 const std::uint32_t* cell = row;
                 for (int i = first[0]; i <= last[0]; ++i, cell += stride[u]) {
@@ -309,13 +313,34 @@ bool walk_group(const Grid& grid, int k, GroupLanes<K, G>& lanes, VisitCell&& vi
                             }
                         }
                         packet_cells = true;
+                        // The packets whose rectangle holds each column of
+                        // the slice's (the first kMaxColumns), and row.
+                        const int columns = std::min(last[0] - first[0] + 1, kMaxColumns);
+                        std::fill(in_column, in_column + columns, 0u);
+                        for (std::uint32_t bits = in_slice; bits; bits &= bits - 1) {
+                            const int q = std::countr_zero(bits);
+                            const int c0 = std::max(packet_first[q][0], first[0]) - first[0];
+                            const int c1 = std::min(packet_last[q][0] - first[0], columns - 1);
+                            for (int c = c0; c <= c1; ++c) in_column[c] |= 1u << q;
+                        }
+                        row_of_packets = -1;
+                    }
+                    if (row_of_packets != j) {
+                        row_of_packets = j;
+                        in_row = 0;
+                        for (std::uint32_t bits = in_slice; bits; bits &= bits - 1) {
+                            const int q = std::countr_zero(bits);
+                            if (packet_first[q][1] <= j && j <= packet_last[q][1]) in_row |= 1u << q;
+                        }
                     }
                     std::uint32_t here = 0;
-                    for (std::uint32_t bits = in_slice; bits; bits &= bits - 1) {
-                        const int q = std::countr_zero(bits);
-                        if (packet_first[q][0] <= i && i <= packet_last[q][0] && packet_first[q][1] <= j &&
-                            j <= packet_last[q][1])
-                            here |= 1u << q;
+                    if (i - first[0] < kMaxColumns) {
+                        here = in_column[i - first[0]] & in_row;
+                    } else {
+                        for (std::uint32_t bits = in_row; bits; bits &= bits - 1) {
+                            const int q = std::countr_zero(bits);
+                            if (packet_first[q][0] <= i && i <= packet_last[q][0]) here |= 1u << q;
+                        }
                     }
                     if (visit_cell(std::uint32_t(cell - begin), here, walking)) return true;
                 }
