@@ -415,7 +415,7 @@ TEST(BvhBuilders, SpatialSplitsCutConesAtTheDiscsThatReachThePlane) {
         const float position = box.lo[axis] + unit(rng) * (box.hi[axis] - box.lo[axis]);
         Box3f left, right;
         split_cone(base, rb, apex, ra, box, axis, position, left, right);
-        // Surface points: an orthonormal frame around the axis, in double.
+        // Surface points around the axis (a float frame, the points in double).
         const Vec3f w = normalize(apex - base);
         const Vec3f t = normalize(std::fabs(w.x) < 0.9f ? cross(w, Vec3f{1, 0, 0}) : cross(w, Vec3f{0, 1, 0}));
         const Vec3f b = cross(w, t);

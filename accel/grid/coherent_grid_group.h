@@ -121,8 +121,8 @@ bool walk_group(const Grid& grid, int k, GroupLanes<K, G>& lanes, VisitCell&& vi
     // planes of a slice within the lines of its extreme slopes from that
     // point, so its rectangle there takes a few scalar products, not a
     // vector pass over its lanes and four reductions.
-    bool one_point = true;
-    float origin[3];
+    bool one_point = n > 0;
+    float origin[3] = {0, 0, 0};
     float packet_slope_lo[G][2], packet_slope_hi[G][2];
     auto packet_slopes = [&](int q) RAYPACK_INLINE_LAMBDA {
         const RayPacket<K>& ray = lanes.packet[q]->ray;
@@ -188,11 +188,9 @@ bool walk_group(const Grid& grid, int k, GroupLanes<K, G>& lanes, VisitCell&& vi
     // it; reduced to cells only in slices with a non-empty cell.
     F packet_lo[G][2], packet_hi[G][2];
     int packet_first[G][2], packet_last[G][2];
-    // The union of the packets' rectangles between planes i0 and i1, and the
-    // packets that have a lane there.
     // Between planes at distances d0 and d1 from the point along k, the
-    // lines of slopes [slope_lo, slope_hi] along axis axes[i] (the lines,
-    // not the segments: a superset of every lane's cells).
+    // lines of slopes [s_lo, s_hi] along axis axes[i] (the lines, not the
+    // segments: a superset of every lane's cells).
     float slice_d0 = 0, slice_d1 = 0;
     auto point_span = [&](int i, float s_lo, float s_hi, float& lo, float& hi) RAYPACK_INLINE_LAMBDA {
         const float o = origin[axes[i]];
@@ -213,6 +211,8 @@ bool walk_group(const Grid& grid, int k, GroupLanes<K, G>& lanes, VisitCell&& vi
         }
         return walking != 0;
     };
+    // The union of the packets' rectangles between planes i0 and i1, and the
+    // packets that have a lane there.
     auto rectangle = [&](int i0, int i1, int first[2], int last[2], std::uint32_t& in_slice) RAYPACK_INLINE_LAMBDA {
         if (one_point) return rectangle_from_point(i0, i1, first, last, in_slice);
         F lo[2] = {inf, inf}, hi[2] = {-inf, -inf};

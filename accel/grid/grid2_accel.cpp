@@ -131,8 +131,9 @@ bool Grid2Accel::walk(Rayf& ray, Hitf& hit, GridRayCounters* counters) const {
 // slice (coherent_grid.h), in groups where consecutive packets share it
 // (coherent_grid_group.h); in each non-empty top cell the lanes that cross
 // its grid walk that grid the same way, a group's packets together (or, if
-// they spread there, each packet alone, and its lanes each their own DDA). Lanes the top walk gives up on, and packets that are
-// not coherent, finish one ray at a time from where they are.
+// they spread there, each packet alone, and its lanes each their own DDA).
+// Lanes the top walk gives up on, and packets that are not coherent, finish
+// one ray at a time from where they are.
 template <int K, bool AnyHit, SlabMethod Slabs>
 bool Grid2Accel::visit_top_cell(const PacketRecordIntersector<vfloat<K>>& isect, int k, std::uint32_t c,
                                 RayPacket<K>& ray, HitPacket<K>& hit, vmask<K>& active, const vfloat<K>& entry,

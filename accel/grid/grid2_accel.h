@@ -2,7 +2,7 @@
 // Two-level grid (`--accel grid2`, two_level_grid.h): single rays walk the
 // top grid's cells with a 3D-DDA and, in each non-empty cell, that cell's
 // own grid over the same stretch of the ray; coherent packets walk both
-// levels slice by slice (coherent_grid.h), the top one in groups of 128 rays
+// levels slice by slice (coherent_grid.h), in groups of 128 rays
 // (coherent_grid_group.h).
 #include <cstdint>
 
