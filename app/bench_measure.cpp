@@ -11,6 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "accel/threads_spread.h"
 #include "measure/ray_sets.h"
 #include "scene/ray_file.h"
 
@@ -58,7 +59,9 @@ void trace_block(const Accel& accel, int packet, bool any_hit, std::span<const R
 void trace_all(const Accel& accel, int packet, bool any_hit, std::span<const Rayf> rays, std::span<Hitf> hits,
                std::size_t grain) {
     const std::size_t n = rays.size();
+    ThreadsSpread spread;  // one CPU per thread
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, (n + grain - 1) / grain), [&](const auto& r) {
+        spread.enter();
         for (std::size_t b = r.begin(); b < r.end(); ++b) {
             const std::size_t lo = b * grain, count = std::min(n, lo + grain) - lo;
             trace_block(accel, packet, any_hit, rays.subspan(lo, count), hits.subspan(lo, count));

@@ -15,6 +15,7 @@
 #include "accel/bvh/wide_packet.h"
 #include "accel/kdtree/kdtree_packet.h"
 #include "accel/octree/octree_packet.h"
+#include "accel/threads_spread.h"
 #include "scene/load.h"
 #include "scene/ray_file.h"
 
@@ -30,7 +31,9 @@ constexpr std::size_t kBatch = 4096;
 double trace_all(const Accel& accel, int packet, const RayFile& file, std::vector<Hitf>& hits) {
     const auto start = std::chrono::steady_clock::now();
     const std::size_t n = file.rays.size();
+    ThreadsSpread spread;  // one CPU per thread
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, (n + kBatch - 1) / kBatch), [&](const auto& r) {
+        spread.enter();
         for (std::size_t b = r.begin(); b < r.end(); ++b) {
             const std::size_t lo = b * kBatch, hi = std::min(n, lo + kBatch);
             const std::span<const Rayf> rays(file.rays.data() + lo, hi - lo);
