@@ -10,6 +10,7 @@
 #include <optional>
 
 #include "accel/bvh/bvh_builders.h"
+#include "accel/threads_spread.h"
 #include "app/accel_options.h"
 #include "app/bench_measure.h"
 #include "app/bench_tradeoff_report.h"
@@ -259,7 +260,9 @@ double time_shadow_pass(const Scene& scene, const Accel& accel, const RayOffset&
     const auto start = std::chrono::steady_clock::now();
     const Vec3f light = scene.lights.front().position;
     constexpr std::size_t kBatch = 4096;
+    ThreadsSpread spread;  // one CPU per thread, as the other timed passes
     tbb::parallel_for(std::size_t(0), camera.size(), kBatch, [&](std::size_t b) {
+        spread.enter();
         const std::size_t end = std::min(camera.size(), b + kBatch);
         for (std::size_t i = b; i < end; ++i) {
             const Surface s = surface_at(scene, camera[i], hits[i]);
