@@ -33,6 +33,9 @@ inline Vec3f smooth_normal(const TriangleSoA& t, std::uint32_t i, const Hitf& hi
 /// hits of secondary rays land anywhere in the scene, and surface_at's reads
 /// of the material, the primitive table and three vertex arrays missed the
 /// cache (8% of a path-traced bunny). Built once per render.
+template <int K>
+struct SurfaceLanes;  // render/surface_lanes.h
+
 class SurfaceTable {
 public:
     explicit SurfaceTable(const Scene& scene);
@@ -41,6 +44,8 @@ public:
     Surface at(const Rayf& ray, const Hitf& hit, float time = -std::numeric_limits<float>::infinity()) const;
 
 private:
+    template <int K>
+    friend struct SurfaceLanes;
     enum Kind : std::uint32_t { kFlatTriangle, kSmoothTriangle, kSphere, kOther };
     struct Record {
         Vec3f v;                     ///< triangle: unit geometric normal; sphere: centre
@@ -53,11 +58,15 @@ private:
 
 inline Surface SurfaceTable::at(const Rayf& ray, const Hitf& hit, float time) const {
     if (hit.prim >= records_.size()) return surface_at(scene_, ray, hit, time);  // inside an instance
-    const Record r = records_[hit.prim];
+    // Field by field from the table: a copy of the whole record went
+    // through the stack and its 4-byte reads stalled on the 16-byte store
+    // (store forwarding; 14% of the surface loop's samples).
+    const Record& r = records_[hit.prim];
+    const std::uint32_t material_kind = r.material_kind;
     Surface s;
     s.point = ray.org + ray.dir * hit.t;
-    s.material = r.material_kind >> 2;
-    switch (Kind(r.material_kind & 3)) {
+    s.material = material_kind >> 2;
+    switch (Kind(material_kind & 3)) {
         case kFlatTriangle:
             s.geometric_normal = s.shading_normal = r.v;
             return s;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -17,6 +18,7 @@
 #include "render/shade_lanes.h"
 #include "render/shading_points.h"
 #include "render/surface.h"
+#include "render/surface_lanes.h"
 #include "render/thin_lens.h"
 #include "render/tiles.h"
 
@@ -149,6 +151,10 @@ public:
         for (const Material& m : scene.materials) {
             specular_cutoff_.push_back(specular_cutoff(m.shine));
             ambient_.push_back(m.color * (intensity_ * m.kd));  // add_point's ambient term
+            spawns_ = spawns_ || m.ks > 0 || m.transmittance > 0;
+            material_light_.push_back(m.area_light);
+            const float terms[7] = {m.color.x, m.color.y, m.color.z, m.kd, m.ks, m.shine, specular_cutoff_.back()};
+            for (int k = 0; k < 7; ++k) material_terms_[k].push_back(terms[k]);
         }
     }
 
@@ -222,10 +228,16 @@ private:
     float intensity_ = 1;
     std::vector<float> specular_cutoff_;  ///< per material, see specular_cutoff
     std::vector<Vec3f> ambient_;          ///< per material, the ambient term
+    /// Per material, for the surface loop's gathers: its area light (or -1),
+    /// and its colour, kd, ks, shine and specular cut-off as ShadingPoints
+    /// stores them.
+    std::vector<std::int32_t> material_light_;
+    std::vector<float> material_terms_[7];
     Sampler samples_;        ///< camera samples: pixel position, lens, glossy lobes
     Sampler light_samples_;  ///< points on area lights
     bool timed_;             ///< rays carry times (RayTree::time)
     bool lanes_;             ///< hits become shading points in SIMD lanes (add_points_in_lanes)
+    bool spawns_ = false;    ///< some material reflects or transmits (spawn_reflection)
 
     /// Closest hits of the tree's rays [begin, end) (eye rays or bounces),
     /// at their times if timed.
@@ -287,7 +299,7 @@ private:
                                      n_light, intensity_, facing_point, offset_, s.shadows.per_light[bucket]);
             }
         }
-        if (depth < options_.max_depth) {
+        if (depth < options_.max_depth && spawns_) {
             // All reflection rays of the level, then all refraction rays: a
             // point's two children go opposite ways, so interleaved they
             // would make every packet of the next level incoherent.
@@ -329,96 +341,100 @@ private:
         s.spawn.push_back({p, surf.material, front});
     }
 
-    /// add_point for the rays [begin, end), bit for bit, the hits' view
-    /// directions, normals and offset points in SIMD lanes: hits gathered
-    /// K at a time in ray order (so the points keep add_point's order) and
-    /// written in place into s.points, misses and lights' surfaces coloured
-    /// on the way.
+    /// add_point for the rays [begin, end), bit for bit, K rays at a time
+    /// in SIMD lanes: their surfaces gathered (SurfaceLanes), view
+    /// directions, normals and offset points computed in the lanes, and the
+    /// lanes that are shaded packed into s.points in ray order (the order
+    /// add_point gives); misses and lights' surfaces coloured on the way.
     void add_points_in_lanes(std::size_t begin, std::size_t end, Scratch& s) const {
         constexpr int K = kShadeLanes;
         static_assert(K <= int(ShadingPoints::kSpare));
         using F = vfloat<K>;
+        using I = vint<K>;
         RayTree& tree = s.tree;
-        alignas(64) float dir[3][K], gn[3][K], sn[3][K], point[3][K];
-        std::uint32_t material[K];
-        int n = 0;
-        ShadingPoints::Block out = s.points.next_block();
-        const auto flush = [&] {
-            for (int l = n; l < K; ++l)  // unused lanes repeat the first
-                for (int a = 0; a < 3; ++a) {
-                    dir[a][l] = dir[a][0];
-                    gn[a][l] = gn[a][0];
-                    sn[a][l] = sn[a][0];
-                    point[a][l] = point[a][0];
-                }
-            const auto load3 = [](const float (&v)[3][K]) {
-                return Vec3<F>{F::load_aligned(v[0]), F::load_aligned(v[1]), F::load_aligned(v[2])};
+        // Where a point's reflection and refraction rays start, and its
+        // material for the distant lights.
+        const bool spawn = spawns_ || !scene_.distant_lights.empty();
+        alignas(64) std::int32_t iota[K];
+        for (int l = 0; l < K; ++l) iota[l] = l;
+        const I lanes = I::load_aligned(iota);
+        SurfaceLanes<K> surf;
+        alignas(64) std::int32_t material[K];
+        alignas(64) float point[3][K];
+        for (std::size_t i0 = begin; i0 < end; i0 += K) {
+            const int count = int(std::min<std::size_t>(K, end - i0));
+            std::uint32_t found = 0;
+            for (int l = 0; l < count; ++l) found |= std::uint32_t(tree.hits[i0 + std::size_t(l)].found()) << l;
+            for (std::uint32_t bits = ~found & ((2u << (count - 1)) - 1); bits != 0; bits &= bits - 1)
+                tree.color[i0 + std::size_t(std::countr_zero(bits))] = scene_.background;
+            if (found == 0) continue;
+            // Lanes past the last ray read the last one (masked off).
+            const I last(std::int32_t(i0) + count - 1), index = I(std::int32_t(i0)) + lanes;
+            const I clamped = xsimd::select(index > last, last, index);
+            surf.gather(surfaces_, tree.rays.data(), tree.hits.data(), clamped, found);
+            surf.material.store_aligned(material);
+            // A light's own surface shows the light's colour.
+            // Most blocks lie on one material: its terms once.
+            const std::int32_t first = first_lane<K>(surf.material, found);
+            const bool one_material = (int_mask_bits<K>(surf.material == I(first)) & found) == found;
+            const auto terms = [&](int k) {
+                return one_material ? F(material_terms_[k][std::size_t(first)])
+                                    : gather_floats<K>(material_terms_[k].data(), surf.material);
             };
-            const Vec3<F> d = load3(dir);
+            const std::uint32_t lit =
+                found & (one_material ? (material_light_[std::size_t(first)] >= 0 ? ~0u : 0u)
+                                      : int_mask_bits<K>(gather_ints<K>(material_light_.data(), surf.material) >= I(0)));
+            const std::uint32_t shaded = found & ~lit;
+            for (std::uint32_t bits = found; bits != 0; bits &= bits - 1) {
+                const int l = std::countr_zero(bits);
+                const Material& m = scene_.materials[std::size_t(material[l])];
+                tree.color[i0 + std::size_t(l)] = (lit >> l) & 1u ? scene_.area_lights[std::size_t(m.area_light)].color
+                                                                  : ambient_[std::size_t(material[l])];
+            }
+            if (shaded == 0) continue;
+            const Vec3<F>& d = surf.direction;
             const Vec3<F> v = d / vsqrt(dot(d, d));
             Vec3<F> ng, ns;
-            const auto front = face_viewer(v, load3(gn), load3(sn), ng, ns);
-            const Vec3<F> up = offset_lanes(offset_, load3(point), ng);
+            const auto front = face_viewer(v, surf.geometric_normal, surf.shading_normal, ng, ns);
+            const Vec3<F> up = offset_lanes(offset_, surf.point, ng);
+            const ShadingPoints::Block out = s.points.next_block();
+            store_packed<K>(out.ray, I(std::int32_t(i0)) + lanes, shaded);
             for (int a = 0; a < 3; ++a) {
-                store_lanes(out.view[a], v[a]);
-                store_lanes(out.ns[a], ns[a]);
-                store_lanes(out.ng[a], ng[a]);
-                store_lanes(out.above[a], up[a]);
+                store_packed<K>(out.view[a], v[a], shaded);
+                store_packed<K>(out.ns[a], ns[a], shaded);
+                store_packed<K>(out.ng[a], ng[a], shaded);
+                store_packed<K>(out.above[a], up[a], shaded);
+                store_packed<K>(out.color[a], terms(a), shaded);
             }
-            s.points.commit(std::size_t(n));
+            store_packed<K>(out.kd, terms(3), shaded);
+            store_packed<K>(out.ks, terms(4), shaded);
+            store_packed<K>(out.shine, terms(5), shaded);
+            store_packed<K>(out.cutoff, terms(6), shaded);
+            s.points.commit(std::size_t(std::popcount(shaded)));
+            if (!spawn) continue;
+            for (int a = 0; a < 3; ++a) surf.point[a].store_aligned(point[a]);
             const std::uint32_t front_bits = mask_bits(front);
-            for (int l = 0; l < n; ++l) {
+            for (std::uint32_t bits = shaded; bits != 0; bits &= bits - 1) {
+                const int l = std::countr_zero(bits);
                 SpawnPoint& sp = s.spawn.emplace_back();
                 sp.p.x = point[0][l];
                 sp.p.y = point[1][l];
                 sp.p.z = point[2][l];
-                sp.material = material[l];
+                sp.material = std::uint32_t(material[l]);
                 sp.front = (front_bits >> l) & 1u;
             }
-            n = 0;
-            out = s.points.next_block();
-        };
-        for (std::size_t i = begin; i < end; ++i) {
-            const Hitf& hit = tree.hits[i];
-            if (!hit.found()) {
-                tree.color[i] = scene_.background;
-                continue;
-            }
-            const Rayf& r = tree.rays[i];
-            const Surface surf = surfaces_.at(r, hit);
-            const Material& m = scene_.materials[surf.material];
-            if (m.area_light >= 0) {
-                // A light's own surface shows the light's colour.
-                tree.color[i] = scene_.area_lights[std::size_t(m.area_light)].color;
-                continue;
-            }
-            tree.color[i] = ambient_[surf.material];
-            for (int a = 0; a < 3; ++a) {
-                dir[a][n] = r.dir[a];
-                gn[a][n] = surf.geometric_normal[a];
-                sn[a][n] = surf.shading_normal[a];
-                point[a][n] = surf.point[a];
-                out.color[a][n] = m.color[a];
-            }
-            out.ray[n] = std::int32_t(i);
-            out.kd[n] = m.kd;
-            out.ks[n] = m.ks;
-            out.shine[n] = m.shine;
-            out.cutoff[n] = specular_cutoff_[surf.material];
-            material[n] = surf.material;
-            if (++n == K) flush();
         }
-        if (n > 0) flush();
     }
 
     /// The unit-square points of every area light's samples at every
     /// shading point of the level, all at once (Sampler::get_many).
     void draw_area_light_samples(int depth, Scratch& s) const {
         const int n_light = light_samples_.spp();
-        s.draws.clear();
+        s.draws.resize(s.points.size() * std::size_t(n_light));
+        Sampler::Draw* draw = s.draws.data();
         for (std::size_t j = 0; j < s.points.size(); ++j) {
             const Sampler::Pixel key = light_samples_.pixel(s.tree.sample[std::size_t(s.points.ray(j))]);
-            for (int k = 0; k < n_light; ++k) s.draws.push_back({key, k});
+            for (int k = 0; k < n_light; ++k) *draw++ = {key, k};
         }
         s.light_drawn.resize(scene_.area_lights.size() * s.draws.size());
         for (std::size_t a = 0; a < scene_.area_lights.size(); ++a)
@@ -535,17 +551,29 @@ private:
     /// the unoccluded contributions in light order, as the recursion did.
     void trace_shadows(Scratch& s) const {
         ShadowBatch& b = s.shadows;
-        b.all.clear();
-        for (const ShadowQueue& q : b.per_light) b.all.insert(b.all.end(), q.rays.begin(), q.rays.end());
-        if (b.all.empty()) return;
-        b.occluded.resize(b.all.size());
+        std::size_t total = 0, queues = 0;
+        const ShadowQueue* only = nullptr;
+        for (const ShadowQueue& q : b.per_light)
+            if (!q.rays.empty()) total += q.rays.size(), ++queues, only = &q;
+        if (total == 0) return;
+        // One light's rays are traced where they are (the copy was 3% of a
+        // Cornell box's render); several lights' are gathered in light order.
+        std::span<const Rayf> all;
+        if (queues == 1) {
+            all = only->rays;
+        } else {
+            b.all.clear();
+            for (const ShadowQueue& q : b.per_light) b.all.insert(b.all.end(), q.rays.begin(), q.rays.end());
+            all = b.all;
+        }
+        b.occluded.resize(total);
         b.times.clear();
         if (timed_)
             for (const ShadowQueue& q : b.per_light)
                 for (const std::int32_t owner : q.owner) b.times.push_back(s.tree.time[std::size_t(owner)]);
-        if (options_.ray_log) options_.ray_log->add(RayLog::Shadow, b.all, b.times);
-        if (timed_) accel_.occluded_at(options_.secondary_packet, b.all, b.times, b.occluded);
-        else accel_.occluded_packets(options_.secondary_packet, b.all, b.occluded);
+        if (options_.ray_log) options_.ray_log->add(RayLog::Shadow, all, b.times);
+        if (timed_) accel_.occluded_at(options_.secondary_packet, all, b.times, b.occluded);
+        else accel_.occluded_packets(options_.secondary_packet, all, b.occluded);
         std::size_t k = 0;
         for (const ShadowQueue& q : b.per_light)
             for (std::size_t j = 0; j < q.rays.size(); ++j, ++k)

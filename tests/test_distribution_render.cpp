@@ -13,6 +13,8 @@
 #include "accel/accel.h"
 #include "render/whitted.h"
 #include "scene/load.h"
+#include "scene/nff_text.h"
+#include "test_paths.h"
 
 namespace raypack {
 namespace {
@@ -265,9 +267,33 @@ TEST(DistributionRender, SurfacesInLanesAreTheScalarPointsBitForBit) {
     // Hits become shading points in SIMD lanes (WhittedOptions::surface_lanes)
     // in both integrators: against one by one on scenes with parallelogram
     // and sphere lights (whose surfaces camera rays see), a lens, glossy and
-    // glass surfaces, both offsets the lanes compute.
-    for (const char* spec : {"gen:cornell:2", "gen:balls:2:area-lights+lens+glossy", "gen:rings:1"}) {
-        const Scene s = load_scene(spec);
+    // glass surfaces, both offsets the lanes compute; smooth triangles
+    // (teapot), cones (rings), and instanced primitives beside the scene's
+    // own in one block of lanes (the lanes gather records of the scene's
+    // primitives and fall back to one by one for the others).
+    const std::string instanced = R"(v
+from 0 -6 2
+at 0 0 0
+up 0 0 1
+angle 40
+hither 0.01
+resolution 40 40
+b 0.1 0.1 0.2
+l 2 -4 5
+f 0.8 0.3 0.3 0.7 0.5 20 0 1
+begin leaf
+s 0 0 0.5 0.5
+p 3 -1 -1 0 1 -1 0 0 1 0
+end
+inst leaf 1 0 0 -1  0 1 0 0  0 0 1 0
+inst leaf 0 -2 0 1.5  1 0 0 0  0 0 2 0
+s 0 0.5 -0.5 0.6
+p 4 -3 -3 -1 3 -3 -1 3 3 -1 -3 3 -1
+)";
+    const std::vector<std::string> specs = {"gen:cornell:2", "gen:balls:2:area-lights+lens+glossy", "gen:rings:1",
+                                            std::string(RAYPACK_SOURCE_DIR) + "/scenes/teapot.nff", "instanced"};
+    for (const std::string& spec : specs) {
+        const Scene s = spec == "instanced" ? load_nff_text(instanced, "instanced.nff") : load_scene(spec);
         const auto accel = build_accel(s, AccelConfig{});
         for (const bool sampled : {false, true}) {
             for (const OffsetPolicy offset : {OffsetPolicy::Scaled, OffsetPolicy::Epsilon}) {

@@ -1,0 +1,131 @@
+#pragma once
+// SurfaceTable::at for K hits at once, in SIMD lanes: the records, rays and
+// hits gathered lane by lane, the same operations in the same order (FMA
+// contraction is off), so every lane holds at()'s bits. Out of lanes: a
+// scalar at() per hit and a copy of its Surface into lane arrays was most of
+// the shading loop's time (store forwarding and dependent loads per hit).
+#include <cstdint>
+
+#include "kernels/simd.h"
+#include "render/gather_lanes.h"
+#include "render/surface.h"
+
+namespace raypack {
+
+template <int K>
+struct SurfaceLanes {
+    using F = vfloat<K>;
+    using I = vint<K>;
+    Vec3<F> point, geometric_normal, shading_normal;
+    Vec3<F> direction;  ///< the ray's
+    I material;         ///< 0 in the lanes left out
+
+    /// The surfaces of hits[index[l]] of rays[index[l]] for the lanes
+    /// `lanes` (found hits; at the shutter's opening). Lanes outside `lanes`
+    /// hold garbage, but their `index` must still be a valid ray.
+    void gather(const SurfaceTable& table, const Rayf* rays, const Hitf* hits, const I& index, std::uint32_t lanes) {
+        static_assert(sizeof(Hitf) == 16 && sizeof(Rayf) == 32 && sizeof(SurfaceTable::Record) == 16);
+        static_assert(sizeof(PrimRef) == 8 && sizeof(Vec3f) == 12);
+        alignas(64) std::int32_t lane_bit[K];
+        for (int l = 0; l < K; ++l) lane_bit[l] = std::int32_t(1u << l);
+        const auto in_lanes = (I(std::int32_t(lanes)) & I::load_aligned(lane_bit)) != I(0);
+        const auto* hit_words = reinterpret_cast<const float*>(hits);
+        const auto* ray_words = reinterpret_cast<const float*>(rays);
+        const I hit4 = shift_left<K>(index, 2), ray8 = shift_left<K>(index, 3);
+        const I prim = gather_ints<K>(reinterpret_cast<const std::int32_t*>(hits), hit4 + I(1));
+        // Primitives inside instances have no record (prim >= records).
+        const auto recorded = in_lanes & (prim >= I(0)) & (prim < I(std::int32_t(table.records_.size())));
+        const std::uint32_t recorded_bits = int_mask_bits<K>(recorded);
+        I material_kind(std::int32_t(SurfaceTable::kOther));
+        Vec3<F> v{F(0.0f), F(0.0f), F(0.0f)};  // lanes without a record: unused
+        if (recorded_bits != 0) {
+            const std::int32_t first = first_lane<K>(prim, recorded_bits);
+            if ((int_mask_bits<K>(prim == I(first)) & recorded_bits) == recorded_bits) {
+                // One primitive in every lane (a large triangle, a near
+                // sphere): its record once.
+                const SurfaceTable::Record& r = table.records_[std::size_t(first)];
+                material_kind = I(std::int32_t(r.material_kind));
+                v = {F(r.v.x), F(r.v.y), F(r.v.z)};
+            } else {
+                const I record4 = shift_left<K>(xsimd::select(recorded, prim, I(first)), 2);
+                const auto* record_words = reinterpret_cast<const float*>(table.records_.data());
+                material_kind = gather_ints<K>(reinterpret_cast<const std::int32_t*>(record_words), record4 + I(3));
+                v = {gather_floats<K>(record_words, record4), gather_floats<K>(record_words, record4 + I(1)),
+                     gather_floats<K>(record_words, record4 + I(2))};
+            }
+        }
+        material = xsimd::select(recorded, shift_right<K>(material_kind, 2), I(0));
+        const I kind = material_kind & I(3);
+        const F t = gather_floats<K>(hit_words, hit4);
+        const Vec3<F> org{gather_floats<K>(ray_words, ray8), gather_floats<K>(ray_words, ray8 + I(1)),
+                          gather_floats<K>(ray_words, ray8 + I(2))};
+        const Vec3<F> dir{gather_floats<K>(ray_words, ray8 + I(3)), gather_floats<K>(ray_words, ray8 + I(4)),
+                          gather_floats<K>(ray_words, ray8 + I(5))};
+        direction = dir;
+        point = org + dir * t;
+        geometric_normal = v;  // flat and smooth triangles
+        shading_normal = v;    // flat triangles
+        const std::uint32_t sphere = lanes & int_mask_bits<K>(recorded & (kind == I(SurfaceTable::kSphere)));
+        const std::uint32_t smooth = lanes & int_mask_bits<K>(recorded & (kind == I(SurfaceTable::kSmoothTriangle)));
+        const std::uint32_t other = lanes & ~int_mask_bits<K>(recorded & (kind != I(SurfaceTable::kOther)));
+        if (sphere != 0) {
+            const Vec3<F> d = point - v;
+            const Vec3<F> n = d / vsqrt(dot(d, d));  // normalize
+            const vmask<K> m = mask_from_bits<K>(sphere);
+            for (int a = 0; a < 3; ++a) {
+                geometric_normal[a] = select(m, n[a], geometric_normal[a]);
+                shading_normal[a] = select(m, n[a], shading_normal[a]);
+            }
+        }
+        if (smooth != 0) {
+            // smooth_normal: the vertex normals at the barycentrics.
+            const TriangleSoA& tri = table.scene_.triangles;
+            const I tri3 = gather_ints<K>(reinterpret_cast<const std::int32_t*>(table.scene_.prims.data()),
+                                          shift_left<K>(xsimd::select(recorded, prim, I(0)), 1) + I(1)) *
+                           I(3);
+            const F u = gather_floats<K>(hit_words, hit4 + I(2)), w2 = gather_floats<K>(hit_words, hit4 + I(3));
+            const F w = F(1.0f) - u - w2;
+            const auto vertex_normal = [&](const std::vector<Vec3f>& n) {
+                const auto* words = reinterpret_cast<const float*>(n.data());
+                return Vec3<F>{gather_floats<K>(words, tri3), gather_floats<K>(words, tri3 + I(1)),
+                               gather_floats<K>(words, tri3 + I(2))};
+            };
+            const Vec3<F> n = vertex_normal(tri.n0) * w + vertex_normal(tri.n1) * u + vertex_normal(tri.n2) * w2;
+            const F len = vsqrt(dot(n, n));
+            const vmask<K> m = mask_from_bits<K>(smooth) & (len > F(0.0f));
+            const Vec3<F> unit = n / len;
+            for (int a = 0; a < 3; ++a) shading_normal[a] = select(m, unit[a], shading_normal[a]);
+        }
+        if (other != 0) {
+            // Cones, height fields and instanced primitives: at(), lane by lane.
+            alignas(64) float lane_arrays[9][K];
+            alignas(64) std::int32_t lane_index[K], lane_material[K];
+            for (int a = 0; a < 3; ++a) {
+                point[a].store_aligned(lane_arrays[a]);
+                geometric_normal[a].store_aligned(lane_arrays[3 + a]);
+                shading_normal[a].store_aligned(lane_arrays[6 + a]);
+            }
+            index.store_aligned(lane_index);
+            material.store_aligned(lane_material);
+            for (std::uint32_t bits = other; bits != 0; bits &= bits - 1) {
+                const int l = std::countr_zero(bits);
+                const auto i = std::size_t(lane_index[l]);
+                const Surface s = table.at(rays[i], hits[i]);
+                for (int a = 0; a < 3; ++a) {
+                    lane_arrays[a][l] = s.point[a];
+                    lane_arrays[3 + a][l] = s.geometric_normal[a];
+                    lane_arrays[6 + a][l] = s.shading_normal[a];
+                }
+                lane_material[l] = std::int32_t(s.material);
+            }
+            for (int a = 0; a < 3; ++a) {
+                point[a] = F::load_aligned(lane_arrays[a]);
+                geometric_normal[a] = F::load_aligned(lane_arrays[3 + a]);
+                shading_normal[a] = F::load_aligned(lane_arrays[6 + a]);
+            }
+            material = I::load_aligned(lane_material);
+        }
+    }
+};
+
+}  // namespace raypack
