@@ -22,6 +22,7 @@
 #include "render/shade_lanes.h"
 #include "render/sin_cos_turns.h"
 #include "render/surface.h"
+#include "render/surface_lanes.h"
 #include "render/thin_lens.h"
 #include "render/tiles.h"
 
@@ -389,19 +390,24 @@ private:
         using F = vfloat<K>;
         const Paths& p = s.paths;
         const int n = int(paths.size());
-        // Gathered per lane: the diffuse vertices' ray direction, normals,
-        // hit point, albedo and part weights, throughput, draws.
-        alignas(64) float dir[3][K], gn[3][K], sn[3][K], point[3][K], albedo[3][K], beta[3][K];
+        // The surfaces in lanes (lanes past the last path repeat it); per
+        // lane, the diffuse vertices' albedo and part weights, throughput
+        // and draws.
+        using I = vint<K>;
+        alignas(64) std::int32_t path_index[K], material[K];
+        for (int l = 0; l < K; ++l) path_index[l] = std::int32_t(paths[std::size_t(l < n ? l : n - 1)]);
+        SurfaceLanes<K> surf;
+        surf.gather(surfaces_, p.rays.data(), p.hits.data(), I::load_aligned(path_index), (2u << (n - 1)) - 1);
+        surf.material.store_aligned(material);
+        alignas(64) float albedo[3][K], beta[3][K];
         alignas(64) float total[K], wd[K], mirror_weight[K], roulette[K], u1[K], u2[K];
         std::uint32_t diffuse = 0, mirror = 0, nothing_to_do = 0;
         const bool spawn = depth < spawn_below_;
         for (int l = 0; l < n; ++l) {
             const std::size_t i = paths[std::size_t(l)];
-            const Hitf& hit = p.hits[i];
-            const Rayf& ray = p.rays[i];
-            const Surface surf = surfaces_.at(ray, hit);
-            if (scene_.materials[surf.material].area_light >= 0) continue;
-            const MaterialParts& q = parts_[surf.material];
+            const auto m = std::size_t(material[l]);
+            if (scene_.materials[m].area_light >= 0) continue;
+            const MaterialParts& q = parts_[m];
             const Sample2 choice = drawn(s, i, 0);
             if (!(q.total > 0)) continue;
             const float pick = choice.x * q.total;
@@ -420,10 +426,6 @@ private:
             }
             const Vec3f b = p.throughput[i];
             for (int a = 0; a < 3; ++a) {
-                dir[a][l] = ray.dir[a];
-                gn[a][l] = surf.geometric_normal[a];
-                sn[a][l] = surf.shading_normal[a];
-                point[a][l] = surf.point[a];
                 albedo[a][l] = q.albedo[a];
                 beta[a][l] = b[a];
             }
@@ -445,15 +447,12 @@ private:
         // Lanes that are not vertices of the lanes compute garbage that is
         // never read; fill them with a copy of one that is, so that nothing
         // traps or slows down on denormals. Mirror lanes' unused draws too.
+        // (Their surfaces are real ones already.)
         const int first = std::countr_zero(in_lanes);
         for (int l = 0; l < K; ++l) {
             if ((mirror >> l) & 1u) u1[l] = u2[l] = 0.0f;
             if ((in_lanes >> l) & 1u) continue;
             for (int a = 0; a < 3; ++a) {
-                dir[a][l] = dir[a][first];
-                gn[a][l] = gn[a][first];
-                sn[a][l] = sn[a][first];
-                point[a][l] = point[a][first];
                 albedo[a][l] = albedo[a][first];
                 beta[a][l] = beta[a][first];
             }
@@ -474,11 +473,11 @@ private:
         };
         // The surface seen from the ray's side (bounce(): its wo = -view, and
         // dot(wo, g) > 0 is dot(view, g) < 0 bit for bit).
-        const Vec3<F> d = load3(dir);
+        const Vec3<F>& d = surf.direction;
         const Vec3<F> view = d / vsqrt(dot(d, d));
         Vec3<F> ng, ns;
-        face_viewer(view, load3(gn), load3(sn), ng, ns);
-        const Vec3<F> above = offset_lanes(offset_, load3(point), ng);
+        face_viewer(view, surf.geometric_normal, surf.shading_normal, ng, ns);
+        const Vec3<F> above = offset_lanes(offset_, surf.point, ng);
         alignas(64) float above_l[3][K];
         store3(above_l, above);
 
