@@ -1,10 +1,59 @@
 #include "accel/threads_spread.h"
 
+#include <sys/stat.h>
+#include <unistd.h>
 #include <tbb/task_arena.h>
+#include <tbb/task_scheduler_observer.h>
 
 #include <algorithm>
+#include <mutex>
+#include <string>
 
 namespace raypack {
+
+namespace {
+
+/// The thread ids of TBB's workers that have entered the arena (they stay
+/// in TBB's pool once made).
+class Workers : public tbb::task_scheduler_observer {
+public:
+    Workers() { observe(true); }
+    ~Workers() override { observe(false); }
+    void on_scheduler_entry(bool is_worker) override {
+        if (!is_worker) return;
+        const int tid = int(gettid());
+        const std::lock_guard<std::mutex> lock(mutex_);
+        if (std::find(tids_.begin(), tids_.end(), tid) == tids_.end()) tids_.push_back(tid);
+    }
+    std::vector<int> tids() {
+        const std::lock_guard<std::mutex> lock(mutex_);
+        return tids_;
+    }
+
+private:
+    std::mutex mutex_;
+    std::vector<int> tids_;
+};
+
+Workers& workers() {
+    static Workers w;
+    return w;
+}
+
+/// Whether thread `tid` is one of this process's (a worker TBB ended
+/// could have left its id to another process's thread).
+bool own_thread(int tid) {
+    struct stat st {};
+    return ::stat(("/proc/self/task/" + std::to_string(tid)).c_str(), &st) == 0;
+}
+
+}  // namespace
+
+void ThreadsSpread::start_workers() {
+    workers();
+    const int slots = tbb::this_task_arena::max_concurrency();
+    for (int k = 1; k < slots; ++k) tbb::this_task_arena::enqueue([] {});
+}
 
 ThreadsSpread::ThreadsSpread() {
     const int slots = tbb::this_task_arena::max_concurrency();
@@ -18,6 +67,15 @@ ThreadsSpread::ThreadsSpread() {
     const auto here = std::find(cpus_.begin(), cpus_.end(), sched_getcpu());
     if (here != cpus_.end()) std::rotate(cpus_.begin(), here, cpus_.end());
     pinned_.assign(std::size_t(slots), 0);
+    // The known workers, each on the next CPU after the caller's, before
+    // the loop wakes them.
+    for (const int tid : workers().tids()) {
+        if (worker_tids_.size() + 1 >= std::size_t(slots) || !own_thread(tid)) continue;
+        cpu_set_t one;
+        CPU_ZERO(&one);
+        CPU_SET(cpus_[next_cpu_.fetch_add(1, std::memory_order_relaxed) % cpus_.size()], &one);
+        if (sched_setaffinity(tid, sizeof one, &one) == 0) worker_tids_.push_back(tid);
+    }
 }
 
 ThreadsSpread::~ThreadsSpread() {
@@ -29,8 +87,10 @@ void ThreadsSpread::enter() {
     const int slot = tbb::this_task_arena::current_thread_index();
     if (slot < 0 || std::size_t(slot) >= pinned_.size() || pinned_[std::size_t(slot)]) return;
     pinned_[std::size_t(slot)] = 1;  // each slot is written by its own thread only
-    // The caller stays where it is; the others take the next CPUs.
+    // The caller stays where it is; the others take the next CPUs (those
+    // pinned before the loop have theirs).
     const bool caller = std::this_thread::get_id() == caller_;
+    if (!caller && std::find(worker_tids_.begin(), worker_tids_.end(), int(gettid())) != worker_tids_.end()) return;
     if (caller) caller_pinned_ = true;
     const std::size_t k = caller ? 0 : next_cpu_.fetch_add(1, std::memory_order_relaxed) % cpus_.size();
     cpu_set_t one;

@@ -16,7 +16,11 @@ namespace raypack {
 /// worker was mostly placed on the waking thread's CPU and left there for
 /// the whole of a short loop: both threads shared one CPU (sched_getcpu per
 /// task), and two threads rendered tetra (8 ms) and traced its camera rays
-/// no faster than one (docs/renderer.md, "Two threads").
+/// no faster than one (docs/renderer.md, "Two threads"). TBB's workers
+/// that have joined the arena before are pinned before the loop starts, so
+/// that the kernel wakes each on its own CPU: pinned only once running,
+/// a worker woken on the caller's CPU waited there for it (0.5-5 ms into a
+/// 5 ms render).
 class ThreadsSpread {
 public:
     ThreadsSpread();
@@ -27,6 +31,11 @@ public:
     /// Pins the calling thread the first time it comes.
     void enter();
 
+    /// Lets TBB's workers join the arena now, without waiting for them,
+    /// so that the first loop finds them known (call early, e.g. before a
+    /// scene loads). Nothing at one thread.
+    static void start_workers();
+
 private:
     std::thread::id caller_ = std::this_thread::get_id();
     bool caller_pinned_ = false;
@@ -34,6 +43,7 @@ private:
     cpu_set_t caller_mask_{};
     std::vector<int> cpus_;     ///< the caller's CPUs, its current one first
     std::vector<char> pinned_;  ///< per worker slot
+    std::vector<int> worker_tids_;  ///< the workers pinned before the loop
 };
 
 }  // namespace raypack

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <unistd.h>
 
+#include "accel/threads_spread.h"
 #include "app/scene_options.h"
 #include "app/accel_options.h"
 #include "app/default_config.h"
@@ -195,6 +196,9 @@ int run_render(const Args& args) {
     // structure builds: started later, it took a core from the render's
     // second thread (a 2-thread tetra render ran no faster than 1 thread).
     start_loading_image_module(output);
+    // The render's second thread joins while the scene loads: its first
+    // wake-up then lands on a CPU of its own (accel/threads_spread.h).
+    ThreadsSpread::start_workers();
 
     auto t0 = std::chrono::steady_clock::now();
     const Scene scene = load_scene_from(p, scene_spec);
