@@ -2,7 +2,10 @@
 // for_each_tile runs them on.
 #include <gtest/gtest.h>
 #include <sched.h>
+#include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <chrono>
 #include <cstring>
@@ -10,6 +13,7 @@
 #include <set>
 #include <vector>
 
+#include "accel/threads_spread.h"
 #include "render/tiles.h"
 
 namespace raypack {
@@ -71,6 +75,53 @@ TEST(Tiles, ThreadsRunOnCpusOfTheirOwn) {
     cpu_set_t after;
     ASSERT_EQ(sched_getaffinity(0, sizeof after, &after), 0);
     EXPECT_TRUE(CPU_EQUAL(&before, &after));
+}
+
+// A worker that has joined the arena before is already on a CPU of its own,
+// not the caller's, when it starts its first task of a loop: pinned by
+// ThreadsSpread before the loop wakes it, not by enter() once running.
+TEST(Tiles, KnownWorkersArePinnedBeforeTheLoopWakesThem) {
+    cpu_set_t all;
+    ASSERT_EQ(sched_getaffinity(0, sizeof all, &all), 0);
+    if (CPU_COUNT(&all) < 2) GTEST_SKIP() << "one CPU allowed";
+    tbb::global_control two(tbb::global_control::max_allowed_parallelism, 2);
+    ThreadsSpread::start_workers();
+    // Until the worker has run a task: each task unpins its thread, so that
+    // only a pin made before the next loop can hold.
+    const auto spin = [] {
+        const auto end = std::chrono::steady_clock::now() + std::chrono::microseconds(200);
+        while (std::chrono::steady_clock::now() < end) {
+        }
+    };
+    bool worker_ran = false;
+    for (int attempt = 0; attempt < 50 && !worker_ran; ++attempt)
+        tbb::parallel_for(tbb::blocked_range<int>(0, 64, 1), [&](const tbb::blocked_range<int>&) {
+            sched_setaffinity(0, sizeof all, &all);
+            spin();
+            if (tbb::this_task_arena::current_thread_index() != 0) worker_ran = true;  // a bool set, never cleared
+        });
+    ASSERT_TRUE(worker_ran) << "the worker never took a task";
+    std::mutex m;
+    bool checked = false;
+    {
+        ThreadsSpread spread;
+        const int caller_cpu = sched_getcpu();
+        tbb::parallel_for(tbb::blocked_range<int>(0, 64, 1), [&](const tbb::blocked_range<int>&) {
+            if (tbb::this_task_arena::current_thread_index() != 0) {
+                cpu_set_t now;
+                ASSERT_EQ(sched_getaffinity(0, sizeof now, &now), 0);
+                const std::lock_guard lock(m);
+                if (!checked) {
+                    EXPECT_EQ(CPU_COUNT(&now), 1) << "the worker was not pinned before its first task";
+                    EXPECT_FALSE(CPU_ISSET(caller_cpu, &now)) << "the worker was pinned to the caller's CPU";
+                    checked = true;
+                }
+            }
+            spread.enter();
+            spin();
+        });
+    }
+    if (!checked) GTEST_SKIP() << "the worker took no task of the loop";
 }
 
 }  // namespace
