@@ -36,7 +36,7 @@ struct SurfaceLanes {
         // Primitives inside instances have no record (prim >= records).
         const auto recorded = in_lanes & (prim >= I(0)) & (prim < I(std::int32_t(table.records_.size())));
         const std::uint32_t recorded_bits = int_mask_bits<K>(recorded);
-        I material_kind(std::int32_t(SurfaceTable::kOther));
+        I material_kind = I(std::int32_t(SurfaceTable::kOther));
         Vec3<F> v{F(0.0f), F(0.0f), F(0.0f)};  // lanes without a record: unused
         if (recorded_bits != 0) {
             const std::int32_t first = first_lane<K>(prim, recorded_bits);
