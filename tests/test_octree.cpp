@@ -131,6 +131,12 @@ void expect_well_formed(const OctreeAccel& accel, const Scene& scene, const Octr
             ASSERT_LE(std::size_t(node.first) + node.count, t.refs.size());
             for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
                 EXPECT_LT(t.refs[k], scene.primitive_count());
+                // The box the groups cull by holds the primitive.
+                const Box3f want = primitive_bounds(scene, t.refs[k]);
+                for (int a = 0; a < 3; ++a) {
+                    EXPECT_LE(t.ref_boxes[k].lo[a], want.lo[a]);
+                    EXPECT_GE(t.ref_boxes[k].hi[a], want.hi[a]);
+                }
                 if (k > node.first) {
                     EXPECT_LT(t.refs[k - 1], t.refs[k]);
                 }
@@ -155,7 +161,10 @@ void expect_well_formed(const OctreeAccel& accel, const Scene& scene, const Octr
     EXPECT_EQ(s.leaves, leaves);
     EXPECT_EQ(s.depth, depth);
     EXPECT_EQ(accel.empty_leaves(), empty);
-    EXPECT_EQ(s.bytes, t.nodes.size() * 8 + (t.refs.size() + t.outside.size()) * 4 + accel.triangle_edge_bytes());
+    // Nodes, references, the references' boxes (24 bytes), triangle records.
+    EXPECT_EQ(t.ref_boxes.size(), t.refs.size());
+    EXPECT_EQ(s.bytes, t.nodes.size() * 8 + (t.refs.size() + t.outside.size()) * 4 + t.refs.size() * 24 +
+                           accel.triangle_edge_bytes());
     EXPECT_GE(s.build_ms, 0.0);
     if (scene.primitive_count()) {
         EXPECT_GE(accel.references_per_primitive(), 1.0);

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <limits>
 
+#include "accel/group_box_culling.h"
 #include "accel/kdtree/kdtree_ray_interval.h"
 #include "accel/outside_prims.h"
 #include "accel/packet_driver.h"
@@ -410,24 +411,9 @@ bool trace_group(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>>
             if (culled) {
                 const std::uint32_t* prims = tree.leaf_prims(node);
                 const float pad = culling_box_pad(cell, g_lo, g_hi);
-                for (std::uint32_t k = 0; k < n_prims; ++k) {
-                    const Box3f b = primitive_bounds(*isect.scene, prims[k]);
-                    std::uint32_t bits = 0;
-                    for (int h = 0; h < H; ++h) {
-                        PF entry(-inf), exit(inf);
-                        for (int a = 0; a < 3; ++a) {
-                            const bool rising = (up >> a) & 1u;
-                            const PF o = PF::load_aligned(o_lo[a] + 8 * h);
-                            const PF rl = PF::load_aligned(r_lo[a] + 8 * h), rh = PF::load_aligned(r_hi[a] + 8 * h);
-                            const PF dn = PF(rising ? b.lo[a] - pad : b.hi[a] + pad) - o;
-                            const PF df = PF(rising ? b.hi[a] + pad : b.lo[a] - pad) - o;
-                            entry = vmax(entry, vmin(dn * rl, dn * rh));
-                            exit = vmin(exit, vmax(df * rl, df * rh));
-                        }
-                        bits |= mask_bits((entry <= exit) & (entry <= tfar[h])) << (8 * h);
-                    }
-                    may_hit[k] = bits;
-                }
+                for (std::uint32_t k = 0; k < n_prims; ++k)
+                    may_hit[k] = packets_meeting_box<G>(o_lo, r_lo, r_hi, up, primitive_bounds(*isect.scene, prims[k]),
+                                                        pad, tfar);
             }
             for (std::uint32_t b = packets; b != 0; b &= b - 1) {
                 const int q = std::countr_zero(b);

@@ -51,6 +51,9 @@ struct Octree {
     Box3f cube;                        ///< the root's box, a cube
     std::vector<OctreeNode> nodes;     ///< nodes[0] is the root; empty if there is nothing to trace
     std::vector<std::uint32_t> refs;   ///< primitive numbers, ascending within each leaf
+    /// The box of each reference's primitive, for groups of packets that
+    /// cull a leaf's primitives before testing them (octree_packet.cpp).
+    std::vector<Box3f> ref_boxes;
     float margin = 0;                  ///< boxes were widened by this for placement
     int depth = 0;                     ///< deepest leaf
     /// Primitives in no leaf, tested by every ray first (accel/outside_prims.h).
@@ -58,7 +61,8 @@ struct Octree {
 
     bool empty() const { return nodes.empty(); }  ///< no leaf holds anything (`outside` may)
     std::size_t bytes() const {
-        return nodes.size() * sizeof(OctreeNode) + (refs.size() + outside.size()) * sizeof(std::uint32_t);
+        return nodes.size() * sizeof(OctreeNode) + (refs.size() + outside.size()) * sizeof(std::uint32_t) +
+               ref_boxes.size() * sizeof(Box3f);
     }
 };
 

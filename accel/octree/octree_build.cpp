@@ -182,6 +182,8 @@ Octree build_octree(std::span<const Box3f> boxes, const PrimitiveBoxOverlap* exa
     flatten(root, 0, 0, tree);
     if (tree.refs.size() >= std::numeric_limits<std::uint32_t>::max())
         throw std::length_error("octree: more references than 32-bit offsets can address");
+    tree.ref_boxes.resize(tree.refs.size());
+    for (std::size_t r = 0; r < tree.refs.size(); ++r) tree.ref_boxes[r] = boxes[tree.refs[r]];
     return tree;
 }
 

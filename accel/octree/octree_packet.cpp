@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "accel/cell_kernel_variants.h"
+#include "accel/group_box_culling.h"
 #include "accel/outside_prims.h"
 #include "accel/ray_box_interval.h"
 #include "accel/packet_driver.h"
@@ -70,11 +71,14 @@ RAYPACK_INLINE std::uint32_t mirrored_children(std::uint32_t bits, unsigned a) {
 /// The primitives refs[0, count) against the lanes `m` of one packet:
 /// closest hits under the tie rule (accel/packet_ties.h), or occlusion
 /// added to `occluded`. The leaf step of both walks below.
-template <int K, bool AnyHit>
+template <int K, bool AnyHit, bool Culled = false>
 RAYPACK_INLINE void test_refs(const PacketRecordIntersector<vfloat<K>>& isect, const std::uint32_t* refs,
                               std::uint32_t count, vmask<K> m, RayPacket<K>& ray, HitPacket<K>& hit,
-                              vmask<K>& occluded) {
+                              vmask<K>& occluded, const std::uint32_t* may_hit = nullptr,
+                              std::uint32_t packet_bit = 0) {
     for (std::uint32_t k = 0; k < count; ++k) {
+        if constexpr (Culled)
+            if (!(may_hit[k] & packet_bit)) continue;
         if constexpr (AnyHit) {
             const vmask<K> h = isect.intersect(m, ray, hit, refs[k]);
             occluded = occluded | h;
@@ -199,6 +203,15 @@ void trace_packet(const Octree& tree, const PacketRecordIntersector<vfloat<K>>& 
 /// / 294 / 297 M against 331 M; mount 399 / 403 / 409 M against 464 M.
 constexpr float kClipBelow = 1.0f / 64.0f;
 
+/// A leaf that this many packets of a group reach, and of at most
+/// kMaxCulledRefs references, first tests its primitives' boxes against
+/// the packets (packets_meeting_box). Against none, camera rays 1024 x
+/// 1024 (the same build, alternating): tetra 1.21x, balls 1.08x, teapot
+/// 1.07x, mount 1.05x, gears 0.95x; from 1, 3 or 8 packets on, within 3% of
+/// 2 (8: tetra 0.92x).
+constexpr int kMinPacketsToCull = 2;
+constexpr std::uint32_t kMaxCulledRefs = 32;
+
 /// A node of the group walk: per packet (in lanes), bounds of its lanes'
 /// slab parameters, by half as in PacketFrame: lo_* bound every lane's from
 /// below, hi_* from above.
@@ -281,12 +294,20 @@ bool trace_group(const Octree& tree, const PacketRecordIntersector<vfloat<K>>& i
     const OctreeNode* nodes = tree.nodes.data();
     const std::uint32_t* refs = tree.refs.data();
     alignas(32) float t0_lo[3][G], t0_hi[3][G], t1_lo[3][G], t1_hi[3][G], near_lo[G], far_hi[G];
+    // Per packet, for culling a leaf's primitives by their boxes: its rays'
+    // origin and reciprocal directions' bounds (packets_meeting_box).
+    alignas(32) float org[3][G], r_lo[3][G], r_hi[3][G];
+    float g_lo[3] = {inf, inf, inf}, g_hi[3] = {-inf, -inf, -inf};  // every packet's origin (culling_box_pad)
+    std::uint32_t up = 0;
+    for (int k = 0; k < 3; ++k) up |= a & (4 >> k) ? 0u : 1u << k;
+    F non_finite(0.0f);
     M lanes[G];  // per packet: the lanes still traced
     std::uint32_t live = 0;
     const Vec3<F> lo = splat<F>(tree.cube.lo), hi = splat<F>(tree.cube.hi);
     for (int q = 0; q < G; ++q) {
         near_lo[q] = inf, far_hi[q] = -inf;  // a packet that enters nothing
-        for (int k = 0; k < 3; ++k) t0_lo[k][q] = t0_hi[k][q] = t1_lo[k][q] = t1_hi[k][q] = 0.0f;
+        for (int k = 0; k < 3; ++k)
+            t0_lo[k][q] = t0_hi[k][q] = t1_lo[k][q] = t1_hi[k][q] = org[k][q] = r_lo[k][q] = r_hi[k][q] = 0.0f;
         if (q >= count) continue;
         const RayPacket<K>& ray = p[q].ray;
         F t0[3], t1[3];
@@ -311,8 +332,19 @@ bool trace_group(const Octree& tree, const PacketRecordIntersector<vfloat<K>>& i
         }
         near_lo[q] = lane_min<K>(select(in, ray.tnear, big));
         far_hi[q] = lane_max<K>(select(in, ray.tfar, -big));
+        for (int k = 0; k < 3; ++k) {  // the packet's rays leave one point (the group's rule)
+            const F o = ray.org[k], r = ray.rdir[k];
+            non_finite = non_finite + select(in, (o - o) + (r - r), F(0.0f));
+            org[k][q] = lane_min<K>(select(in, o, big));
+            r_lo[k][q] = lane_min<K>(select(in, r, big));
+            r_hi[k][q] = lane_max<K>(select(in, r, -big));
+            g_lo[k] = std::min(g_lo[k], org[k][q]);
+            g_hi[k] = std::max(g_hi[k], lane_max<K>(select(in, o, -big)));
+        }
     }
     if (live == 0) return true;
+    // Axis-parallel rays (an infinite reciprocal) bound nothing: no culling.
+    const bool cull = !any(non_finite != non_finite);
     const PF tnear = PF::load_aligned(near_lo);
     PF tfar = PF::load_aligned(far_hi);
     // The packets of `packets` test the leaf, each with its lanes whose ray
@@ -322,13 +354,28 @@ bool trace_group(const Octree& tree, const PacketRecordIntersector<vfloat<K>>& i
     const float clip_margin = 2.0f * tree.margin;
     const float clip_below = (tree.cube.hi[0] - tree.cube.lo[0]) * kClipBelow;
     const auto test_leaf = [&](const OctreeNode& leaf, const Box3f& box, std::uint32_t packets) {
+        // Where enough packets reach the leaf, its primitives' boxes first
+        // (as the k-d tree's groups): each packet then tests only those its
+        // rays may meet.
+        std::uint32_t may_hit[kMaxCulledRefs];
+        const bool culled = cull && leaf.count <= kMaxCulledRefs && std::popcount(packets) >= kMinPacketsToCull;
+        if (culled) {
+            const float pad = culling_box_pad(box, g_lo, g_hi);
+            const PF tf[1] = {tfar};
+            for (std::uint32_t k = 0; k < leaf.count; ++k)
+                may_hit[k] = packets_meeting_box<G>(org, r_lo, r_hi, up, tree.ref_boxes[leaf.first + k], pad, tf);
+        }
         for (; packets != 0; packets &= packets - 1) {
             const int q = std::countr_zero(packets);
             RayPacket<K>& ray = p[q].ray;
             F t0, t1;
             const M in = ray_box_interval<F>(lanes[q], ray.org, ray.rdir, ray.tnear, ray.tfar, box, clip_margin, t0, t1);
             if (none(in)) continue;
-            test_refs<K, AnyHit>(isect, refs + leaf.first, leaf.count, in, ray, p[q].hit, p[q].occluded);
+            if (culled)
+                test_refs<K, AnyHit, true>(isect, refs + leaf.first, leaf.count, in, ray, p[q].hit, p[q].occluded,
+                                           may_hit, 1u << q);
+            else
+                test_refs<K, AnyHit>(isect, refs + leaf.first, leaf.count, in, ray, p[q].hit, p[q].occluded);
             if constexpr (AnyHit) {
                 lanes[q] = lanes[q] & !p[q].occluded;
                 if (none(lanes[q])) live &= ~(1u << q), far_hi[q] = -inf;
