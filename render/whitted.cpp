@@ -373,7 +373,6 @@ private:
             const I clamped = xsimd::select(index > last, last, index);
             surf.gather(surfaces_, tree.rays.data(), tree.hits.data(), clamped, found);
             surf.material.store_aligned(material);
-            // A light's own surface shows the light's colour.
             // Most blocks lie on one material: its terms once.
             const std::int32_t first = first_lane<K>(surf.material, found);
             const bool one_material = (int_mask_bits<K>(surf.material == I(first)) & found) == found;
@@ -381,6 +380,7 @@ private:
                 return one_material ? F(material_terms_[k][std::size_t(first)])
                                     : gather_floats<K>(material_terms_[k].data(), surf.material);
             };
+            // A light's own surface shows the light's colour.
             const std::uint32_t lit =
                 found & (one_material ? (material_light_[std::size_t(first)] >= 0 ? ~0u : 0u)
                                       : int_mask_bits<K>(gather_ints<K>(material_light_.data(), surf.material) >= I(0)));
