@@ -3,7 +3,6 @@
 #include <sys/stat.h>
 #include <unistd.h>
 #include <tbb/task_arena.h>
-#include <tbb/task_scheduler_observer.h>
 
 #include <algorithm>
 #include <mutex>
@@ -13,15 +12,13 @@ namespace raypack {
 
 namespace {
 
-/// The thread ids of TBB's workers that have entered the arena (they stay
-/// in TBB's pool once made).
-class Workers : public tbb::task_scheduler_observer {
+/// The thread ids of TBB's workers that have run a task of a spread loop
+/// or of start_workers (they stay in TBB's pool once made). Recorded from
+/// the tasks themselves: a task_scheduler_observer's registration leaked
+/// at exit (LeakSanitizer).
+class Workers {
 public:
-    Workers() { observe(true); }
-    ~Workers() override { observe(false); }
-    void on_scheduler_entry(bool is_worker) override {
-        if (!is_worker) return;
-        const int tid = int(gettid());
+    void add(int tid) {
         const std::lock_guard<std::mutex> lock(mutex_);
         if (std::find(tids_.begin(), tids_.end(), tid) == tids_.end()) tids_.push_back(tid);
     }
@@ -52,7 +49,10 @@ bool own_thread(int tid) {
 void ThreadsSpread::start_workers() {
     workers();
     const int slots = tbb::this_task_arena::max_concurrency();
-    for (int k = 1; k < slots; ++k) tbb::this_task_arena::enqueue([] {});
+    for (int k = 1; k < slots; ++k)
+        tbb::this_task_arena::enqueue([] {
+            if (tbb::this_task_arena::current_thread_index() > 0) workers().add(int(gettid()));
+        });
 }
 
 ThreadsSpread::ThreadsSpread() {
@@ -90,7 +90,11 @@ void ThreadsSpread::enter() {
     // The caller stays where it is; the others take the next CPUs (those
     // pinned before the loop have theirs).
     const bool caller = std::this_thread::get_id() == caller_;
-    if (!caller && std::find(worker_tids_.begin(), worker_tids_.end(), int(gettid())) != worker_tids_.end()) return;
+    if (!caller) {
+        const int tid = int(gettid());
+        if (std::find(worker_tids_.begin(), worker_tids_.end(), tid) != worker_tids_.end()) return;
+        workers().add(tid);  // known from now on: the next loop pins it before waking it
+    }
     if (caller) caller_pinned_ = true;
     const std::size_t k = caller ? 0 : next_cpu_.fetch_add(1, std::memory_order_relaxed) % cpus_.size();
     cpu_set_t one;

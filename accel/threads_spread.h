@@ -31,8 +31,8 @@ public:
     /// Pins the calling thread the first time it comes.
     void enter();
 
-    /// Lets TBB's workers join the arena now, without waiting for them,
-    /// so that the first loop finds them known (call early, e.g. before a
+    /// Lets TBB's workers run a task now, without waiting for them, so
+    /// that the first loop finds them known (call early, e.g. before a
     /// scene loads). Nothing at one thread.
     static void start_workers();
 

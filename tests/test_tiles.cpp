@@ -86,20 +86,24 @@ TEST(Tiles, KnownWorkersArePinnedBeforeTheLoopWakesThem) {
     if (CPU_COUNT(&all) < 2) GTEST_SKIP() << "one CPU allowed";
     tbb::global_control two(tbb::global_control::max_allowed_parallelism, 2);
     ThreadsSpread::start_workers();
-    // Until the worker has run a task: each task unpins its thread, so that
-    // only a pin made before the next loop can hold.
+    // Until the worker has run a task of a spread loop (which makes it
+    // known): each task then unpins its thread, so that only a pin made
+    // before the next loop can hold.
     const auto spin = [] {
         const auto end = std::chrono::steady_clock::now() + std::chrono::microseconds(200);
         while (std::chrono::steady_clock::now() < end) {
         }
     };
     bool worker_ran = false;
-    for (int attempt = 0; attempt < 50 && !worker_ran; ++attempt)
+    for (int attempt = 0; attempt < 50 && !worker_ran; ++attempt) {
+        ThreadsSpread known;
         tbb::parallel_for(tbb::blocked_range<int>(0, 64, 1), [&](const tbb::blocked_range<int>&) {
+            known.enter();
             sched_setaffinity(0, sizeof all, &all);
             spin();
             if (tbb::this_task_arena::current_thread_index() != 0) worker_ran = true;  // a bool set, never cleared
         });
+    }
     ASSERT_TRUE(worker_ran) << "the worker never took a task";
     std::mutex m;
     bool checked = false;
