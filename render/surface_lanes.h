@@ -66,7 +66,8 @@ struct SurfaceLanes {
         geometric_normal = v;  // flat and smooth triangles
         shading_normal = v;    // flat triangles
         const std::uint32_t sphere = lanes & int_mask_bits<K>(recorded & (kind == I(SurfaceTable::kSphere)));
-        const std::uint32_t smooth = lanes & int_mask_bits<K>(recorded & (kind == I(SurfaceTable::kSmoothTriangle)));
+        const auto smooth_lanes = recorded & (kind == I(SurfaceTable::kSmoothTriangle));
+        const std::uint32_t smooth = lanes & int_mask_bits<K>(smooth_lanes);
         const std::uint32_t other = lanes & ~int_mask_bits<K>(recorded & (kind != I(SurfaceTable::kOther)));
         if (sphere != 0) {
             const Vec3<F> d = point - v;
@@ -78,10 +79,13 @@ struct SurfaceLanes {
             }
         }
         if (smooth != 0) {
-            // smooth_normal: the vertex normals at the barycentrics.
+            // smooth_normal: the vertex normals at the barycentrics. Every
+            // lane reads a smooth triangle's (another primitive's index
+            // could lie past the triangle arrays).
             const TriangleSoA& tri = table.scene_.triangles;
+            const I triangle = xsimd::select(smooth_lanes, prim, I(first_lane<K>(prim, smooth)));
             const I tri3 = gather_ints<K>(reinterpret_cast<const std::int32_t*>(table.scene_.prims.data()),
-                                          shift_left<K>(xsimd::select(recorded, prim, I(0)), 1) + I(1)) *
+                                          shift_left<K>(triangle, 1) + I(1)) *
                            I(3);
             const F u = gather_floats<K>(hit_words, hit4 + I(2)), w2 = gather_floats<K>(hit_words, hit4 + I(3));
             const F w = F(1.0f) - u - w2;
