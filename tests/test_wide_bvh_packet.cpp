@@ -2,7 +2,8 @@
 // single-ray wide traversal and the brute-force oracle, for K = 4, 8, 16,
 // three switch points (never fall back: pure packets; the default; always:
 // every lane alone below the root) and packets alone or in groups of 4 and
-// 16 that share one walk (accel/bvh/wide_group_traversal.h).
+// 16 that share one walk (accel/bvh/wide_group_traversal.h), with and
+// without the any-hit walks' occluder cache (accel/bvh/wide_traversal.h).
 //
 // Against the single-ray traversal (see wide_packet_traversal.h for why):
 // the same hit or miss and the same occlusion on every ray; for the same
@@ -24,6 +25,7 @@
 #include <functional>
 #include <random>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -237,14 +239,20 @@ void check_scene(const Scene& scene, const std::string& label) {
         for (int k : {4, 8, 16}) {
             if (!accel.supports_packet(k)) continue;
             const int fallback = default_wide_switch_below(N, k);
-            const std::pair<int, int> configs[] = {{0, 1}, {fallback, 1}, {k + 1, 1}, {fallback, 4}, {fallback, 16}, {0, 16}};
-            for (auto [below, group] : configs) {
+            // The occluder cache (any hit) on, except in the last two.
+            const std::tuple<int, int, bool> configs[] = {{0, 1, true},         {fallback, 1, true},
+                                                          {k + 1, 1, true},     {fallback, 4, true},
+                                                          {fallback, 16, true}, {0, 16, true},
+                                                          {fallback, 1, false}, {fallback, 16, false}};
+            for (auto [below, group, cached] : configs) {
                 WidePacketConfig c;
                 c.switch_below = below;
                 c.group_packets = group;
+                c.occluder_cache = cached;
                 accel.set_packet_config(k, c);
                 SCOPED_TRACE(label + " bvh" + std::to_string(N) + " " + set.name + " K=" + std::to_string(k) +
-                             " switch_below=" + std::to_string(below) + " group=" + std::to_string(group));
+                             " switch_below=" + std::to_string(below) + " group=" + std::to_string(group) +
+                             (cached ? "" : " no occluder cache"));
                 // Batches of several groups, with a ragged group at their end.
                 const std::vector<Hitf> packet =
                     trace(accel, k, set.any_hit, set.rays, group == 1 ? 61 : std::size_t(group) * k * 3 - 5);

@@ -251,10 +251,11 @@ RAYPACK_INLINE std::array<PacketState<K>, G> packet_states(LoadedPacket<K>* p, i
     return packet_states<K, G>(p, count, std::make_index_sequence<G>());
 }
 
-/// `count` packets (count <= G <= 32) through the tree together.
+/// `count` packets (count <= G <= 32) through the tree together. Any hit
+/// with a `cache`: as trace_packet, each packet tests its leaf first.
 template <int N, int M, int K, int G, TriangleMethod TM, bool AnyHit, bool ByPrim, class Kinds>
 void trace_group(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, int switch_below, float max_origin_spread,
-                 LoadedPacket<K>* p, int count) {
+                 LoadedPacket<K>* p, int count, OccluderCache* cache = nullptr) {
     using F = vfloat<K>;
     PacketNodeRay<K> nr[G];
     const bool together = count > 1 && one_octant<K>(p, count);
@@ -264,7 +265,7 @@ void trace_group(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, int switc
     if (!together || !group_intervals<K>(nr, p, count, g) || origin_spread(g) > max_origin_spread) {
         for (int q = 0; q < count; ++q)
             trace_packet<N, M, K, TM, AnyHit, ByPrim, Kinds>(bvh, pk, switch_below, p[q].ray, p[q].hit, p[q].valid,
-                                                             p[q].occluded);
+                                                             p[q].occluded, cache);
         return;
     }
     const SphereMethod sm = pk.kernels.sphere;
@@ -273,11 +274,16 @@ void trace_group(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, int switc
     auto s = packet_states<K, G>(p, count);
     float tfar_hi[G];  // per packet: the largest widened tfar of its valid lanes
     std::uint32_t live = 0;
+    const bool cached = AnyHit && !ByPrim && cache && !cache->empty();
     for (int q = 0; q < count; ++q) {
         if constexpr (!ByPrim) set_packet_leaf_ray<K>(p[q].ray, TM, lr[q]);
+        if constexpr (AnyHit && !ByPrim)
+            if (cached && any(s[q].valid)) packet_cached<TM, Kinds, M>(*cache, sm, lr[q], s[q].valid, s[q]);
         tfar_hi[q] = lane_max<K>(select(s[q].valid, node_tfar(s[q].tfar), minus_inf));
-        if (any(p[q].valid)) live |= 1u << q;
+        if (any(s[q].valid)) live |= 1u << q;
     }
+    if constexpr (AnyHit)
+        if (live == 0) return;
     // The group's bound on tfar for the interval test: over every packet
     // still traced, renewed after each leaf.
     float tfar_group = group_tfar_hi(tfar_hi, live);
@@ -305,9 +311,10 @@ void trace_group(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, int switc
                 F e;
                 const vmask<K> m = child_hits<N, K>(box_node, slot, nr[q], s[q].valid, node_tfar(s[q].tfar), e);
                 if (none(m)) continue;
+                OccluderCache* const c = AnyHit ? cache : nullptr;
                 if constexpr (ByPrim) packet_leaf_by_prim<AnyHit>(bvh, pk.packet, cur, p[q].ray, m, s[q]);
-                else if (kept > 0) packet_leaf<TM, AnyHit, Kinds, true>(bvh, sm, cur, lr[q], m, s[q], slots);
-                else packet_leaf<TM, AnyHit, Kinds>(bvh, sm, cur, lr[q], m, s[q]);
+                else if (kept > 0) packet_leaf<TM, AnyHit, Kinds, true>(bvh, sm, cur, lr[q], m, s[q], slots, c);
+                else packet_leaf<TM, AnyHit, Kinds>(bvh, sm, cur, lr[q], m, s[q], nullptr, c);
                 tfar_hi[q] = lane_max<K>(select(s[q].valid, node_tfar(s[q].tfar), minus_inf));
                 if constexpr (AnyHit)
                     if (none(s[q].valid)) live &= ~(1u << q);
@@ -369,7 +376,14 @@ void trace_group(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, int switc
         }
         // Pop the next child the group may still meet before its closest hits.
         for (;;) {
-            if (sp == 0) return;
+            if (sp == 0) {
+                if constexpr (AnyHit) {
+                    bool any_occluded = false;
+                    for (int q = 0; q < count; ++q) any_occluded |= any(p[q].occluded & p[q].valid);
+                    if (cache && !any_occluded) cache->clear();
+                }
+                return;
+            }
             --sp;
             cur_packets = stack_packets[sp] & live;
             if (cur_packets != 0 && !(stack_entry[sp] > tfar_group)) break;
@@ -392,10 +406,17 @@ void wide_trace_packets(const WideBvh<N, M>& bvh, const Scene& scene, KernelChoi
         return;
     }
     const wide_packet_detail::PacketKernels<K> pk{kernels, {&scene, kernels}, {&scene, kernels}};
+    // Any hit: the primitive that stopped the last occluded ray, for the
+    // next packets. Not with plain slabs, which may miss the box of a
+    // primitive that the cache would test anyway: packets must answer as
+    // the single rays do.
+    OccluderCache occluder_cache;
+    OccluderCache* const cache =
+        AnyHit && config.occluder_cache && kernels.slabs != SlabMethod::Plain ? &occluder_cache : nullptr;
     auto run = [&]<TriangleMethod TM, bool ByPrim, class Kinds = PrimKinds>() {
         auto trace_packet = [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid, vmask<K>& occluded) {
             wide_packet_detail::trace_packet<N, M, K, TM, AnyHit, ByPrim, Kinds>(bvh, pk, config.switch_below, ray, hit,
-                                                                                 valid, occluded);
+                                                                                 valid, occluded, cache);
         };
         if (config.group_packets > 1) {
             constexpr int G = WidePacketConfig::kMaxGroupPackets;
@@ -409,7 +430,7 @@ void wide_trace_packets(const WideBvh<N, M>& bvh, const Scene& scene, KernelChoi
                 [&](LoadedPacket<K>* p, int count) {
                     for (int first = 0; first < count; first += group)
                         wide_packet_detail::trace_group<N, M, K, G, TM, AnyHit, ByPrim, Kinds>(
-                            bvh, pk, config.switch_below, max_spread, p + first, std::min(group, count - first));
+                            bvh, pk, config.switch_below, max_spread, p + first, std::min(group, count - first), cache);
                 });
             return;
         }

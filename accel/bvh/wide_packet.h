@@ -30,6 +30,10 @@ struct WidePacketConfig {
     /// at most kMaxGroupPackets; 1: each packet alone.
     int group_packets = 1;
     static constexpr int kMaxGroupPackets = 16;
+    /// Any hit: packets test the primitive that stopped the last occluded
+    /// ray first (OccluderCache, accel/bvh/wide_traversal.h); never with
+    /// --slabs plain.
+    bool occluder_cache = true;
 };
 
 /// The default switch point for N-wide trees and packets of K. Measured with

@@ -160,7 +160,8 @@ struct PacketState {
 /// wide_group_traversal.h); the others are tested in the same order.
 template <class Kind, TriangleMethod TM, bool AnyHit, bool Masked = false, int K, class Block>
 RAYPACK_INLINE void packet_run(const Block* b, std::uint32_t count, SphereMethod sm, const LeafRay<vfloat<K>>& r,
-                               vmask<K> active, PacketState<K>& s, const std::uint32_t* slots = nullptr) {
+                               vmask<K> active, PacketState<K>& s, const std::uint32_t* slots = nullptr,
+                               OccluderCache* cache = nullptr) {
     using F = vfloat<K>;
     constexpr int M = int(sizeof(b->prim) / sizeof(b->prim[0]));
     F minus_inf(-std::numeric_limits<float>::infinity());
@@ -177,6 +178,7 @@ RAYPACK_INLINE void packet_run(const Block* b, std::uint32_t count, SphereMethod
             else m = Kind::template intersect_slot<TM, F, M>(*b, j, sm, r, active, s.tfar, t, u, v);
             if (none(m)) continue;
             if constexpr (AnyHit) {
+                if (cache) cache->set<Kind>(b, j);
                 s.occluded = s.occluded | m;
                 s.valid = s.valid & !m;
                 s.tfar = select(m, minus_inf, s.tfar);
@@ -204,11 +206,33 @@ RAYPACK_INLINE void packet_run(const Block* b, std::uint32_t count, SphereMethod
 template <TriangleMethod TM, bool AnyHit, class Kinds, bool Masked = false, int N, int M, int K>
 RAYPACK_INLINE void packet_leaf(const WideBvh<N, M>& bvh, SphereMethod sm, std::uint32_t code,
                                 const LeafRay<vfloat<K>>& r, const vmask<K>& active, PacketState<K>& s,
-                                const std::uint32_t* slots = nullptr) {
+                                const std::uint32_t* slots = nullptr, OccluderCache* cache = nullptr) {
     bvh.template for_each_run<false, Kinds>(code, [&]<class Kind>(const auto* blocks, std::uint32_t n) RAYPACK_INLINE_LAMBDA {
-        packet_run<Kind, TM, AnyHit, Masked>(blocks, n, sm, r, AnyHit ? active & s.valid : active, s, slots);
+        packet_run<Kind, TM, AnyHit, Masked>(blocks, n, sm, r, AnyHit ? active & s.valid : active, s, slots, cache);
         if constexpr (Masked) slots += n;
         return false;
+    });
+}
+
+/// The cached primitive (OccluderCache, not empty) against the active lanes
+/// of an any-hit packet: the occluded ones leave `s.valid`.
+template <TriangleMethod TM, class Kinds, int M, int K>
+RAYPACK_INLINE void packet_cached(const OccluderCache& cache, SphereMethod sm, const LeafRay<vfloat<K>>& r,
+                                  vmask<K> active, PacketState<K>& s) {
+    using F = vfloat<K>;
+    Kinds::dispatch(cache.kind, [&]<class Kind>() RAYPACK_INLINE_LAMBDA {
+        const auto* b = static_cast<const typename Kind::template Block<M>*>(cache.block);
+        F t(0.0f), u(0.0f), v(0.0f);
+        vmask<K> m;
+        if constexpr (names_hits<Kind>) {
+            std::uint32_t ids[K];
+            m = Kind::template intersect_slot<TM, F, M>(*b, cache.slot, sm, r, active, s.tfar, t, u, v, ids);
+        } else {
+            m = Kind::template intersect_slot<TM, F, M>(*b, cache.slot, sm, r, active, s.tfar, t, u, v);
+        }
+        s.occluded = s.occluded | m;
+        s.valid = s.valid & !m;
+        s.tfar = select(m, F(-std::numeric_limits<float>::infinity()), s.tfar);
     });
 }
 
@@ -251,10 +275,12 @@ struct PacketKernels {
 };
 
 /// The lanes `bits` finish the subtree under `root` one ray at a time
-/// (Benthin et al. 2012), each from its own closest hit so far.
+/// (Benthin et al. 2012), each from its own closest hit so far. Any hit:
+/// each lane tests the cached primitive's block first, and the primitive
+/// that stops a lane becomes the cache's.
 template <int N, int M, int K, TriangleMethod TM, bool AnyHit, bool ByPrim, class Kinds>
 void lanes_alone(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, std::uint32_t root, std::uint32_t bits,
-                 const RayPacket<K>& ray, PacketState<K>& s) {
+                 const RayPacket<K>& ray, PacketState<K>& s, OccluderCache* cache) {
     using F = vfloat<K>;
     alignas(64) float org[3][K], dir[3][K], tnear[K], tfar[K], t[K], u[K], v[K];
     for (int a = 0; a < 3; ++a) {
@@ -283,8 +309,15 @@ void lanes_alone(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, std::uint
             lane_hit = trace_wide_subtree<N, M, TM, NodeTest::Ordered, AnyHit, true>(
                 bvh, pk.kernels.sphere, root, nr, LeafRay<vfloat<M>>{}, lane_tfar, h, &p);
         } else {
-            lane_hit = trace_wide_subtree<N, M, TM, NodeTest::Ordered, AnyHit, false, NoTraversalCounts, Kinds>(
-                bvh, pk.kernels.sphere, root, nr, make_leaf_ray<vfloat<M>>(r, TM), lane_tfar, h);
+            const LeafRay<vfloat<M>> lr = make_leaf_ray<vfloat<M>>(r, TM);
+            lane_hit = false;
+            if constexpr (AnyHit) {
+                if (cache && !cache->empty())
+                    lane_hit = occluded_by_cached<TM, Kinds, M>(*cache, pk.kernels.sphere, lr, lane_tfar, h);
+            }
+            if (!lane_hit)
+                lane_hit = trace_wide_subtree<N, M, TM, NodeTest::Ordered, AnyHit, false, NoTraversalCounts, Kinds>(
+                    bvh, pk.kernels.sphere, root, nr, lr, lane_tfar, h, nullptr, {}, AnyHit ? cache : nullptr);
         }
         if (!lane_hit) continue;
         if constexpr (AnyHit) {
@@ -313,9 +346,13 @@ void lanes_alone(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, std::uint
 }
 
 /// One packet through the tree, with leaves compiled for Kinds.
+/// Any hit with a `cache` (OccluderCache): the packet tests its primitive
+/// first, and the last primitive that stops a lane becomes the cache's; a
+/// packet none of whose lanes is stopped empties it, so that scenes with
+/// few shadows pay no test.
 template <int N, int M, int K, TriangleMethod TM, bool AnyHit, bool ByPrim, class Kinds>
 void trace_packet(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, int switch_below, const RayPacket<K>& ray,
-                  HitPacket<K>& hit, vmask<K> valid, vmask<K>& occluded) {
+                  HitPacket<K>& hit, vmask<K> valid, vmask<K>& occluded, OccluderCache* cache = nullptr) {
     using F = vfloat<K>;
     using B = vmask<K>;
     const SphereMethod sm = pk.kernels.sphere;
@@ -333,16 +370,26 @@ void trace_packet(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, int swit
     int sp = 0;
     std::uint32_t cur = 0;
     B active = valid;
+    if constexpr (AnyHit && !ByPrim) {
+        if (cache && !cache->empty()) {
+            packet_cached<TM, Kinds, M>(*cache, sm, lr, active, s);
+            if (none(s.valid)) return;
+            active = s.valid;
+        }
+    }
     for (;;) {
         for (;;) {
             const std::uint32_t bits = mask_bits(active);
             if (std::popcount(bits) < switch_below) {
-                lanes_alone<N, M, K, TM, AnyHit, ByPrim, Kinds>(bvh, pk, cur, bits, ray, s);
+                lanes_alone<N, M, K, TM, AnyHit, ByPrim, Kinds>(bvh, pk, cur, bits, ray, s, cache);
                 break;
             }
             if (wide_child::is_leaf(cur)) {
-                if constexpr (ByPrim) packet_leaf_by_prim<AnyHit>(bvh, pk.packet, cur, ray, active, s);
-                else packet_leaf<TM, AnyHit, Kinds>(bvh, sm, cur, lr, active, s);
+                if constexpr (ByPrim) {
+                    packet_leaf_by_prim<AnyHit>(bvh, pk.packet, cur, ray, active, s);
+                } else {
+                    packet_leaf<TM, AnyHit, Kinds>(bvh, sm, cur, lr, active, s, nullptr, AnyHit ? cache : nullptr);
+                }
                 break;
             }
             const WideNode<N>& node = nodes[cur];
@@ -387,7 +434,11 @@ void trace_packet(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, int swit
             if (none(s.valid)) return;
         // Pop the next child some lane still meets before its closest hit.
         for (;;) {
-            if (sp == 0) return;
+            if (sp == 0) {
+                if constexpr (AnyHit)
+                    if (cache && none(s.occluded & valid)) cache->clear();
+                return;
+            }
             --sp;
             active = s.valid & (F::load_aligned(stack_entry[sp]) <= node_tfar(s.tfar));
             if (any(active)) break;
