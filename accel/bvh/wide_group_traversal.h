@@ -252,7 +252,7 @@ RAYPACK_INLINE std::array<PacketState<K>, G> packet_states(LoadedPacket<K>* p, i
 }
 
 /// `count` packets (count <= G <= 32) through the tree together. Any hit
-/// with a `cache`: as trace_packet, each packet tests its leaf first.
+/// with a `cache`: as trace_packet, each packet tests its primitive first.
 template <int N, int M, int K, int G, TriangleMethod TM, bool AnyHit, bool ByPrim, class Kinds>
 void trace_group(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, int switch_below, float max_origin_spread,
                  LoadedPacket<K>* p, int count, OccluderCache* cache = nullptr) {
