@@ -100,6 +100,65 @@ std::unique_ptr<OctreeAccel> make_octree(const Scene& scene, const OctreeConfig&
     return std::make_unique<OctreeAccel>(scene, AccelConfig{}, oc);
 }
 
+/// The references in the leaves under node i, ascending, once each.
+std::vector<std::uint32_t> subtree_refs(const Octree& t, std::uint32_t i) {
+    std::vector<std::uint32_t> out;
+    std::vector<std::uint32_t> pending = {i};
+    while (!pending.empty()) {
+        const OctreeNode& n = t.nodes[pending.back()];
+        pending.pop_back();
+        if (n.is_leaf()) out.insert(out.end(), t.refs.begin() + n.first, t.refs.begin() + n.first + n.count);
+        else
+            for (std::uint32_t c = 0; c < 8; ++c) pending.push_back(n.first + c);
+    }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+}
+
+/// The groups' leaves are the highest inner nodes whose leaves hold at most
+/// group_leaf_size primitives, and hold exactly those, ascending, with
+/// boxes that hold them.
+void expect_group_leaves(const Octree& t, const Scene& scene, const OctreeConfig& oc) {
+    // (node, inside a group leaf already)
+    std::vector<std::pair<std::uint32_t, bool>> pending = {{0, false}};
+    std::size_t found = 0;
+    while (!pending.empty()) {
+        const auto [i, inside] = pending.back();
+        pending.pop_back();
+        const OctreeNode& node = t.nodes[i];
+        const OctreeNode& whole = t.group_leaves[i];
+        if (node.is_leaf()) {
+            EXPECT_FALSE(whole.is_leaf()) << "a leaf of the tree is not also a group leaf";
+            continue;
+        }
+        const std::vector<std::uint32_t> under = subtree_refs(t, i);
+        const bool small = under.size() <= std::size_t(oc.group_leaf_size);
+        EXPECT_EQ(whole.is_leaf(), small && !inside) << "node " << i << " over " << under.size() << " primitives";
+        if (whole.is_leaf()) {
+            ++found;
+            ASSERT_LE(std::size_t(whole.first) + whole.count, t.group_refs.size());
+            const std::vector<std::uint32_t> held(t.group_refs.begin() + whole.first,
+                                                  t.group_refs.begin() + whole.first + whole.count);
+            EXPECT_EQ(held, under) << "node " << i;
+            for (std::uint32_t k = whole.first; k < whole.first + whole.count; ++k) {
+                const Box3f want = primitive_bounds(scene, t.group_refs[k]);
+                for (int a = 0; a < 3; ++a) {
+                    EXPECT_LE(t.group_ref_boxes[k].lo[a], want.lo[a]);
+                    EXPECT_GE(t.group_ref_boxes[k].hi[a], want.hi[a]);
+                }
+            }
+        }
+        for (std::uint32_t c = 0; c < 8; ++c) pending.push_back({node.first + c, inside || whole.is_leaf()});
+    }
+    std::size_t total = 0;
+    for (const OctreeNode& g : t.group_leaves) total += g.is_leaf() ? g.count : 0;
+    EXPECT_EQ(total, t.group_refs.size());
+    if (oc.group_leaf_size == 0) {
+        EXPECT_EQ(found, 0u);
+    }
+}
+
 /// Structural invariants: leaves obey leaf_size unless at max depth or
 /// unsplittable, references ascend within leaves and are in range, inner
 /// nodes mark exactly their empty children, and the statistics count what
@@ -161,10 +220,14 @@ void expect_well_formed(const OctreeAccel& accel, const Scene& scene, const Octr
     EXPECT_EQ(s.leaves, leaves);
     EXPECT_EQ(s.depth, depth);
     EXPECT_EQ(accel.empty_leaves(), empty);
-    // Nodes, references, the references' boxes (24 bytes), triangle records.
+    // Nodes, references, the references' boxes (24 bytes), the groups'
+    // leaves (a node each, their references and boxes), triangle records.
     EXPECT_EQ(t.ref_boxes.size(), t.refs.size());
-    EXPECT_EQ(s.bytes, t.nodes.size() * 8 + (t.refs.size() + t.outside.size()) * 4 + t.refs.size() * 24 +
-                           accel.triangle_edge_bytes());
+    EXPECT_EQ(t.group_ref_boxes.size(), t.group_refs.size());
+    EXPECT_EQ(t.group_leaves.size(), t.nodes.size());
+    EXPECT_EQ(s.bytes, t.nodes.size() * 16 + (t.refs.size() + t.group_refs.size() + t.outside.size()) * 4 +
+                           (t.refs.size() + t.group_refs.size()) * 24 + accel.triangle_edge_bytes());
+    expect_group_leaves(t, scene, oc);
     EXPECT_GE(s.build_ms, 0.0);
     if (scene.primitive_count()) {
         EXPECT_GE(accel.references_per_primitive(), 1.0);

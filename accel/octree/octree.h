@@ -29,6 +29,11 @@ struct OctreeConfig {
     /// Packets of one direction octant walk the tree in groups
     /// (octree_packet.cpp, trace_group); false: each packet alone.
     bool packet_groups = true;
+    /// To the groups, an inner node holding at most this many references is
+    /// a leaf (Octree::group_leaves): they cull its primitives by their
+    /// boxes at once instead of walking down to the leaves of leaf_size
+    /// that single rays want (0: none).
+    int group_leaf_size = 24;
 };
 
 /// 8 bytes. Inner: `first` is the index of child 0, the eight children follow
@@ -56,13 +61,21 @@ struct Octree {
     std::vector<Box3f> ref_boxes;
     float margin = 0;                  ///< boxes were widened by this for placement
     int depth = 0;                     ///< deepest leaf
+    /// Per node: for the highest inner nodes of at most
+    /// OctreeConfig::group_leaf_size references, their references
+    /// (group_refs[first .. first + count], boxes in group_ref_boxes), which
+    /// groups of packets test as one leaf; other nodes count = kInner.
+    std::vector<OctreeNode> group_leaves;
+    std::vector<std::uint32_t> group_refs;
+    std::vector<Box3f> group_ref_boxes;
     /// Primitives in no leaf, tested by every ray first (accel/outside_prims.h).
     std::vector<std::uint32_t> outside;
 
     bool empty() const { return nodes.empty(); }  ///< no leaf holds anything (`outside` may)
     std::size_t bytes() const {
-        return nodes.size() * sizeof(OctreeNode) + (refs.size() + outside.size()) * sizeof(std::uint32_t) +
-               ref_boxes.size() * sizeof(Box3f);
+        return (nodes.size() + group_leaves.size()) * sizeof(OctreeNode) +
+               (refs.size() + group_refs.size() + outside.size()) * sizeof(std::uint32_t) +
+               (ref_boxes.size() + group_ref_boxes.size()) * sizeof(Box3f);
     }
 };
 

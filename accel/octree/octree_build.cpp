@@ -25,6 +25,8 @@ float max_abs_coord(const Box3f& b) {
 struct BuildNode {
     std::vector<std::uint32_t> refs;
     std::unique_ptr<std::array<BuildNode, 8>> kids;
+    /// An inner node that is a leaf to groups of packets: its references.
+    std::vector<std::uint32_t> group_refs;
 };
 
 class Builder {
@@ -33,7 +35,7 @@ public:
         : boxes_(boxes), exact_(exact), config_(config), margin_(margin) {}
 
     /// Splits `node` (box [lo, hi], at `depth`) recursively.
-    void subdivide(BuildNode& node, const Vec3d& lo, const Vec3d& hi, int depth) const {
+    void subdivide(BuildNode& node, const Vec3d& lo, const Vec3d& hi, int depth, bool in_group_leaf = false) const {
         const std::size_t n = node.refs.size();
         if (n <= std::size_t(std::max(config_.leaf_size, 0)) || depth >= std::min(config_.max_depth, kOctreeMaxDepth)) return;
         const Vec3d mid = (lo + hi) * 0.5;
@@ -70,6 +72,9 @@ public:
         int full = 0;
         for (const auto& r : child_refs) full += r.size() == n;
         if (full >= std::max(1, config_.full_children_stop)) return;
+        // The highest node of at most group_leaf_size references keeps them.
+        const bool group_leaf = !in_group_leaf && n <= std::size_t(std::max(config_.group_leaf_size, 0));
+        if (group_leaf) node.group_refs = node.refs;
         node.refs.clear();
         node.refs.shrink_to_fit();
         node.kids = std::make_unique<std::array<BuildNode, 8>>();
@@ -78,7 +83,7 @@ public:
             kid.refs = std::move(child_refs[c]);
             Vec3d clo, chi;
             child_box(c, lo, mid, hi, clo, chi);
-            subdivide(kid, clo, chi, depth + 1);
+            subdivide(kid, clo, chi, depth + 1, in_group_leaf || group_leaf);
         };
         // Parallel near the root, where subtrees are large.
         if (n >= 4096) {
@@ -120,6 +125,11 @@ void flatten(const BuildNode& b, std::uint32_t index, int depth, Octree& tree) {
         if (kid.kids || !kid.refs.empty()) occupied |= 1u << c;
     }
     tree.nodes[index] = {std::uint32_t(base), OctreeNode::kInner | occupied};
+    tree.group_leaves.resize(tree.nodes.size(), OctreeNode{0, OctreeNode::kInner});
+    if (!b.group_refs.empty()) {
+        tree.group_leaves[index] = {std::uint32_t(tree.group_refs.size()), std::uint32_t(b.group_refs.size())};
+        tree.group_refs.insert(tree.group_refs.end(), b.group_refs.begin(), b.group_refs.end());
+    }
     for (int c = 0; c < 8; ++c) flatten((*b.kids)[c], std::uint32_t(base + c), depth + 1, tree);
 }
 
@@ -179,11 +189,15 @@ Octree build_octree(std::span<const Box3f> boxes, const PrimitiveBoxOverlap* exa
     const Builder builder(boxes, exact, config, tree.margin);
     builder.subdivide(root, Vec3d(tree.cube.lo), Vec3d(tree.cube.hi), 0);
     tree.nodes.resize(1);
+    tree.group_leaves.resize(1, OctreeNode{0, OctreeNode::kInner});
     flatten(root, 0, 0, tree);
+    tree.group_leaves.resize(tree.nodes.size(), OctreeNode{0, OctreeNode::kInner});
     if (tree.refs.size() >= std::numeric_limits<std::uint32_t>::max())
         throw std::length_error("octree: more references than 32-bit offsets can address");
     tree.ref_boxes.resize(tree.refs.size());
     for (std::size_t r = 0; r < tree.refs.size(); ++r) tree.ref_boxes[r] = boxes[tree.refs[r]];
+    tree.group_ref_boxes.resize(tree.group_refs.size());
+    for (std::size_t r = 0; r < tree.group_refs.size(); ++r) tree.group_ref_boxes[r] = boxes[tree.group_refs[r]];
     return tree;
 }
 

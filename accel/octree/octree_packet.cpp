@@ -353,17 +353,19 @@ bool trace_group(const Octree& tree, const PacketRecordIntersector<vfloat<K>>& i
     // group's bound on the lanes' tfar shrinks with their hits.
     const float clip_margin = 2.0f * tree.margin;
     const float clip_below = (tree.cube.hi[0] - tree.cube.lo[0]) * kClipBelow;
-    const auto test_leaf = [&](const OctreeNode& leaf, const Box3f& box, std::uint32_t packets) {
+    // A leaf: `count` references from `leaf_refs` with their boxes.
+    const auto test_leaf = [&](const std::uint32_t* leaf_refs, const Box3f* leaf_boxes, std::uint32_t count,
+                               const Box3f& box, std::uint32_t packets) {
         // Where enough packets reach the leaf, its primitives' boxes first
         // (as the k-d tree's groups): each packet then tests only those its
         // rays may meet.
         std::uint32_t may_hit[kMaxCulledRefs];
-        const bool culled = cull && leaf.count <= kMaxCulledRefs && std::popcount(packets) >= kMinPacketsToCull;
+        const bool culled = cull && count <= kMaxCulledRefs && std::popcount(packets) >= kMinPacketsToCull;
         if (culled) {
             const float pad = culling_box_pad(box, g_lo, g_hi);
             const PF tf[1] = {tfar};
-            for (std::uint32_t k = 0; k < leaf.count; ++k)
-                may_hit[k] = packets_meeting_box<G>(org, r_lo, r_hi, up, tree.ref_boxes[leaf.first + k], pad, tf);
+            for (std::uint32_t k = 0; k < count; ++k)
+                may_hit[k] = packets_meeting_box<G>(org, r_lo, r_hi, up, leaf_boxes[k], pad, tf);
         }
         for (; packets != 0; packets &= packets - 1) {
             const int q = std::countr_zero(packets);
@@ -372,10 +374,9 @@ bool trace_group(const Octree& tree, const PacketRecordIntersector<vfloat<K>>& i
             const M in = ray_box_interval<F>(lanes[q], ray.org, ray.rdir, ray.tnear, ray.tfar, box, clip_margin, t0, t1);
             if (none(in)) continue;
             if (culled)
-                test_refs<K, AnyHit, true>(isect, refs + leaf.first, leaf.count, in, ray, p[q].hit, p[q].occluded,
-                                           may_hit, 1u << q);
+                test_refs<K, AnyHit, true>(isect, leaf_refs, count, in, ray, p[q].hit, p[q].occluded, may_hit, 1u << q);
             else
-                test_refs<K, AnyHit>(isect, refs + leaf.first, leaf.count, in, ray, p[q].hit, p[q].occluded);
+                test_refs<K, AnyHit>(isect, leaf_refs, count, in, ray, p[q].hit, p[q].occluded);
             if constexpr (AnyHit) {
                 lanes[q] = lanes[q] & !p[q].occluded;
                 if (none(lanes[q])) live &= ~(1u << q), far_hi[q] = -inf;
@@ -385,10 +386,20 @@ bool trace_group(const Octree& tree, const PacketRecordIntersector<vfloat<K>>& i
         }
         tfar = PF::load_aligned(far_hi);
     };
-    if (nodes[0].is_leaf()) {
-        test_leaf(nodes[0], tree.cube, live);
+    // A leaf of the tree, or an inner node that is a leaf to groups.
+    const auto test_node = [&](std::uint32_t index, const Box3f& box, std::uint32_t packets) {
+        const OctreeNode node = nodes[index];
+        if (node.is_leaf()) {
+            test_leaf(refs + node.first, tree.ref_boxes.data() + node.first, node.count, box, packets);
+            return true;
+        }
+        const OctreeNode whole = tree.group_leaves[index];
+        if (!whole.is_leaf()) return false;
+        test_leaf(tree.group_refs.data() + whole.first, tree.group_ref_boxes.data() + whole.first, whole.count, box,
+                  packets);
         return true;
-    }
+    };
+    if (test_node(0, tree.cube, live)) return true;
     GroupFrame stack[kOctreeMaxDepth + 1];
     int sp = 0;
     GroupFrame* f = &stack[0];
@@ -410,7 +421,7 @@ bool trace_group(const Octree& tree, const PacketRecordIntersector<vfloat<K>>& i
         f->left &= f->left - 1;
         const std::uint32_t entering = f->packets & live;
         if (entering == 0) continue;
-        const OctreeNode node = nodes[f->children + (unsigned(c) ^ unsigned(a))];
+        const std::uint32_t index = f->children + (unsigned(c) ^ unsigned(a));
         const std::uint8_t* half = kHalfIndex[c];
         const PF* lo_enter = &f->lo_enter[0][0];
         const PF* hi_leave = &f->hi_leave[0][0];
@@ -419,12 +430,12 @@ bool trace_group(const Octree& tree, const PacketRecordIntersector<vfloat<K>>& i
         const std::uint32_t packets = entering & mask_bits(vmax(enter, tnear) <= vmin(leave, tfar));
         if (packets == 0) continue;
         const unsigned real = unsigned(c) ^ unsigned(a);
-        if (node.is_leaf()) {
-            test_leaf(node, f->child_box(real), packets);
+        if (test_node(index, f->child_box(real), packets)) {
             if constexpr (AnyHit)
                 if (live == 0) return true;
             continue;
         }
+        const OctreeNode node = nodes[index];
         // Small nodes clip the packets to their box too (see kClipBelow).
         const Box3f box = f->child_box(real);
         std::uint32_t clipped = packets;
