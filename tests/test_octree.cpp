@@ -132,6 +132,7 @@ void expect_group_leaves(const Octree& t, const Scene& scene, const OctreeConfig
             EXPECT_FALSE(whole.is_leaf()) << "a leaf of the tree is not also a group leaf";
             continue;
         }
+        EXPECT_EQ(node.group_leaf(), whole.is_leaf()) << "node " << i << ": its flag";
         const std::vector<std::uint32_t> under = subtree_refs(t, i);
         const bool small = under.size() <= std::size_t(oc.group_leaf_size);
         EXPECT_EQ(whole.is_leaf(), small && !inside) << "node " << i << " over " << under.size() << " primitives";

@@ -39,16 +39,21 @@ struct OctreeConfig {
 /// 8 bytes. Inner: `first` is the index of child 0, the eight children follow
 /// in the order of Revelles et al. (bit 4 = upper half in x, 2 = y, 1 = z),
 /// and `count` is kInner with bit c set for each child c that is not an
-/// empty leaf, so that walks skip empty children without reading them.
+/// empty leaf, so that walks skip empty children without reading them,
+/// and kGroupLeaf if Octree::group_leaves holds its references.
 /// Leaf: refs[first .. first + count].
 struct OctreeNode {
-    static constexpr std::uint32_t kInner = 0xFFFFFF00u;
+    static constexpr std::uint32_t kInner = 0xFFFFFE00u;
+    /// Inner nodes: set when the node is a leaf to groups (Octree::group_leaves).
+    static constexpr std::uint32_t kGroupLeaf = 0x100u;
     std::uint32_t first = 0;
     std::uint32_t count = 0;
 
     bool is_leaf() const { return count < kInner; }
     /// Inner nodes: the children that are not empty leaves (bit c: child c).
     std::uint32_t occupied() const { return count & 0xFFu; }
+    /// Inner nodes: whether groups of packets take it as a leaf.
+    bool group_leaf() const { return (count & kGroupLeaf) != 0; }
 };
 static_assert(sizeof(OctreeNode) == 8, "octree nodes are two 32-bit words");
 

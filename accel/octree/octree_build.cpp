@@ -124,9 +124,10 @@ void flatten(const BuildNode& b, std::uint32_t index, int depth, Octree& tree) {
         const BuildNode& kid = (*b.kids)[c];
         if (kid.kids || !kid.refs.empty()) occupied |= 1u << c;
     }
-    tree.nodes[index] = {std::uint32_t(base), OctreeNode::kInner | occupied};
+    const std::uint32_t group_leaf = b.group_refs.empty() ? 0u : OctreeNode::kGroupLeaf;
+    tree.nodes[index] = {std::uint32_t(base), OctreeNode::kInner | group_leaf | occupied};
     tree.group_leaves.resize(tree.nodes.size(), OctreeNode{0, OctreeNode::kInner});
-    if (!b.group_refs.empty()) {
+    if (group_leaf) {
         tree.group_leaves[index] = {std::uint32_t(tree.group_refs.size()), std::uint32_t(b.group_refs.size())};
         tree.group_refs.insert(tree.group_refs.end(), b.group_refs.begin(), b.group_refs.end());
     }

@@ -393,8 +393,8 @@ bool trace_group(const Octree& tree, const PacketRecordIntersector<vfloat<K>>& i
             test_leaf(refs + node.first, tree.ref_boxes.data() + node.first, node.count, box, packets);
             return true;
         }
+        if (!node.group_leaf()) return false;
         const OctreeNode whole = tree.group_leaves[index];
-        if (!whole.is_leaf()) return false;
         test_leaf(tree.group_refs.data() + whole.first, tree.group_ref_boxes.data() + whole.first, whole.count, box,
                   packets);
         return true;
