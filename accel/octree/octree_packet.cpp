@@ -269,7 +269,8 @@ RAYPACK_INLINE int packet_octant(const LoadedPacket<K>& p) {
 // operation). A packet enters a child when its bounds allow one of its
 // lanes to (max of the lower entries <= min of the upper exits, within its
 // lanes' [tnear, tfar]): every leaf a lane's own walk reaches, and more.
-// A packet reaching a leaf (or a small inner node, kClipBelow) clips its
+// A packet reaching a leaf (a node of at most OctreeConfig::group_leaf_size
+// primitives is one to groups; also a small inner node, kClipBelow) clips its
 // lanes to the node's box, widened by twice the placement margin (which
 // covers the rounding of a lane's own parameters, octree_build.cpp), and
 // the lanes left test the leaf's primitives: each lane tests at least the
