@@ -3,6 +3,7 @@
 // octree, k-d tree) share: the hand-made scenes they are all held to brute
 // force on, and the rays built from each structure's own planes that make its
 // walk stumble (the grid's are in tests/grid_test_rays.h).
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -307,7 +308,24 @@ inline std::vector<Rayf> packet_group_rays(const Scene& scene, std::vector<Rayf>
                 if (octant == 8 ? u(rng) < 0.0f : ((octant >> a) & 1) != 0) d[a] = -d[a];
             rays.push_back(Rayf{inside, d, 0.0f, std::numeric_limits<float>::infinity()});
         }
+    // The camera rays again, each run of 128 led by 16 from the camera and
+    // followed by rays from origins spread over 2% of the scene, aimed at
+    // the same points: a group led by one point must not take its
+    // followers for rays from one point too.
+    std::vector<Rayf> spread;
+    const float jitter = 0.02f * std::max({box.extent().x, box.extent().y, box.extent().z});
+    for (std::size_t i = 0; i < hits.size(); ++i) {
+        Rayf r = rays[i];
+        if (i % 128 >= 16) {
+            const Vec3f target = hits[i].found() ? r.org + r.dir * hits[i].t : r.org + r.dir;
+            r.org = r.org + Vec3f{u(rng), u(rng), u(rng)} * jitter;
+            r.dir = target - r.org;
+            r.tfar = std::numeric_limits<float>::infinity();
+        }
+        spread.push_back(r);
+    }
     rays.insert(rays.end(), from_light.begin(), from_light.end());
+    rays.insert(rays.end(), spread.begin(), spread.end());
     return rays;
 }
 

@@ -279,7 +279,7 @@ bool trace_group(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>>
     const float inf = std::numeric_limits<float>::infinity();
     const F finf(inf), zero(0.0f);
     M lanes[G];  // per packet: the lanes still traced
-    alignas(32) float o_lo[3][G], o_hi[3][G], r_lo[3][G], r_hi[3][G], r_abs[3][G], t_in[G], t_out[G], t_far[G];
+    alignas(32) float org[3][G], r_lo[3][G], r_hi[3][G], r_abs[3][G], t_in[G], t_out[G], t_far[G];
     std::uint32_t up = 0, down = 0, live = 0;
     F non_finite = zero;
     for (int q = 0; q < count; ++q) {
@@ -291,21 +291,21 @@ bool trace_group(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>>
         const std::uint32_t bits = mask_bits(in);
         if (bits == 0) continue;
         live |= 1u << q;
+        const int first = std::countr_zero(bits);
         for (int a = 0; a < 3; ++a) {
             const std::uint32_t pos = mask_bits(ray.rdir[a] >= zero) & bits;
             up |= pos != 0 ? 1u << a : 0u;
             down |= pos != bits ? 1u << a : 0u;
             const F o = ray.org[a], r = ray.rdir[a];
             non_finite = non_finite + select(in, (o - o) + (r - r), zero);
-            o_lo[a][q] = lane_min<K>(select(in, o, finf));
-            o_hi[a][q] = lane_max<K>(select(in, o, -finf));
-            r_lo[a][q] = lane_min<K>(select(in, r, finf));
-            r_hi[a][q] = lane_max<K>(select(in, r, -finf));
-            r_abs[a][q] = std::max(std::fabs(r_lo[a][q]), std::fabs(r_hi[a][q]));
             // Bounds by intervals are tight only for rays from one point:
             // packets whose origins spread walk alone (shadow rays from a
             // patch, nearly parallel to a split, would bound nothing).
-            if (o_lo[a][q] != o_hi[a][q]) return false;
+            org[a][q] = lane(o, first);
+            if (mask_bits(o != F(org[a][q])) & bits) return false;
+            r_lo[a][q] = lane_min<K>(select(in, r, finf));
+            r_hi[a][q] = lane_max<K>(select(in, r, -finf));
+            r_abs[a][q] = std::max(std::fabs(r_lo[a][q]), std::fabs(r_hi[a][q]));
         }
         t_in[q] = lane_min<K>(select(in, t0, finf));
         t_out[q] = lane_max<K>(select(in, t1, -finf));
@@ -315,7 +315,7 @@ bool trace_group(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>>
     if (live == 0) return true;
     for (int q = 0; q < G; ++q)  // packets without a lane in the box, or past the group: empty intervals
         if (!((live >> q) & 1u)) {
-            for (int a = 0; a < 3; ++a) o_lo[a][q] = o_hi[a][q] = r_lo[a][q] = r_hi[a][q] = r_abs[a][q] = 0.0f;
+            for (int a = 0; a < 3; ++a) org[a][q] = r_lo[a][q] = r_hi[a][q] = r_abs[a][q] = 0.0f;
             t_in[q] = inf, t_out[q] = -inf, t_far[q] = -inf;
         }
     float g_lo[3], g_hi[3];  // the packets' origins, all of them (culling_box_pad)
@@ -323,7 +323,7 @@ bool trace_group(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>>
         g_lo[a] = inf, g_hi[a] = -inf;
         for (std::uint32_t b = live; b != 0; b &= b - 1) {
             const int q = std::countr_zero(b);
-            g_lo[a] = std::min(g_lo[a], o_lo[a][q]), g_hi[a] = std::max(g_hi[a], o_hi[a][q]);
+            g_lo[a] = std::min(g_lo[a], org[a][q]), g_hi[a] = std::max(g_hi[a], org[a][q]);
         }
     }
     PF tfar[H], enter[H], leave[H];
@@ -360,14 +360,14 @@ bool trace_group(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>>
             PF near_hi[H], far_lo[H];
             std::uint32_t near_packets = 0, far_packets = 0;
             for (int h = 0; h < H; ++h) {
-                const PF d0 = split - PF::load_aligned(o_hi[a] + 8 * h), d1 = split - PF::load_aligned(o_lo[a] + 8 * h);
+                const PF d = split - PF::load_aligned(org[a] + 8 * h);
                 const PF rl = PF::load_aligned(r_lo[a] + 8 * h), rh = PF::load_aligned(r_hi[a] + 8 * h);
-                const PF c0 = d0 * rl, c1 = d0 * rh, c2 = d1 * rl, c3 = d1 * rh;
+                const PF c0 = d * rl, c1 = d * rh;
                 const PF slack = margin * PF::load_aligned(r_abs[a] + 8 * h);
                 // Whichever way the rays go, the near side ends at t_split +
                 // slack and the far side starts at t_split - slack.
-                const PF near_end = vmax(vmax(c0, c1), vmax(c2, c3)) + slack;
-                const PF far_start = vmin(vmin(c0, c1), vmin(c2, c3)) - slack;
+                const PF near_end = vmax(c0, c1) + slack;
+                const PF far_start = vmin(c0, c1) - slack;
                 near_hi[h] = vmin(leave[h], near_end);
                 far_lo[h] = vmax(enter[h], far_start);
                 near_packets |= mask_bits((enter[h] <= near_hi[h]) & (enter[h] <= tfar[h])) << (8 * h);
@@ -412,7 +412,7 @@ bool trace_group(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>>
                 const std::uint32_t* prims = tree.leaf_prims(node);
                 const float pad = culling_box_pad(cell, g_lo, g_hi);
                 for (std::uint32_t k = 0; k < n_prims; ++k)
-                    may_hit[k] = packets_meeting_box<G>(o_lo, r_lo, r_hi, up, primitive_bounds(*isect.scene, prims[k]),
+                    may_hit[k] = packets_meeting_box<G>(org, r_lo, r_hi, up, primitive_bounds(*isect.scene, prims[k]),
                                                         pad, tfar);
             }
             for (std::uint32_t b = packets; b != 0; b &= b - 1) {

@@ -333,14 +333,18 @@ bool trace_group(const Octree& tree, const PacketRecordIntersector<vfloat<K>>& i
         }
         near_lo[q] = lane_min<K>(select(in, ray.tnear, big));
         far_hi[q] = lane_max<K>(select(in, ray.tfar, -big));
-        for (int k = 0; k < 3; ++k) {  // the packet's rays leave one point (the group's rule)
+        const int first = std::countr_zero(mask_bits(in));
+        for (int k = 0; k < 3; ++k) {
             const F o = ray.org[k], r = ray.rdir[k];
             non_finite = non_finite + select(in, (o - o) + (r - r), F(0.0f));
-            org[k][q] = lane_min<K>(select(in, o, big));
+            // Every packet's rays leave one point, not only the group's
+            // first: packets_meeting_box culls by one origin per packet.
+            org[k][q] = lane(o, first);
+            if (mask_bits(o != F(org[k][q])) & mask_bits(in)) return false;
             r_lo[k][q] = lane_min<K>(select(in, r, big));
             r_hi[k][q] = lane_max<K>(select(in, r, -big));
             g_lo[k] = std::min(g_lo[k], org[k][q]);
-            g_hi[k] = std::max(g_hi[k], lane_max<K>(select(in, o, -big)));
+            g_hi[k] = std::max(g_hi[k], org[k][q]);
         }
     }
     if (live == 0) return true;
@@ -354,18 +358,18 @@ bool trace_group(const Octree& tree, const PacketRecordIntersector<vfloat<K>>& i
     // group's bound on the lanes' tfar shrinks with their hits.
     const float clip_margin = 2.0f * tree.margin;
     const float clip_below = (tree.cube.hi[0] - tree.cube.lo[0]) * kClipBelow;
-    // A leaf: `count` references from `leaf_refs` with their boxes.
-    const auto test_leaf = [&](const std::uint32_t* leaf_refs, const Box3f* leaf_boxes, std::uint32_t count,
+    // A leaf: `n_refs` references from `leaf_refs` with their boxes.
+    const auto test_leaf = [&](const std::uint32_t* leaf_refs, const Box3f* leaf_boxes, std::uint32_t n_refs,
                                const Box3f& box, std::uint32_t packets) {
         // Where enough packets reach the leaf, its primitives' boxes first
         // (as the k-d tree's groups): each packet then tests only those its
         // rays may meet.
         std::uint32_t may_hit[kMaxCulledRefs];
-        const bool culled = cull && count <= kMaxCulledRefs && std::popcount(packets) >= kMinPacketsToCull;
+        const bool culled = cull && n_refs <= kMaxCulledRefs && std::popcount(packets) >= kMinPacketsToCull;
         if (culled) {
             const float pad = culling_box_pad(box, g_lo, g_hi);
             const PF tf[1] = {tfar};
-            for (std::uint32_t k = 0; k < count; ++k)
+            for (std::uint32_t k = 0; k < n_refs; ++k)
                 may_hit[k] = packets_meeting_box<G>(org, r_lo, r_hi, up, leaf_boxes[k], pad, tf);
         }
         for (; packets != 0; packets &= packets - 1) {
@@ -375,9 +379,9 @@ bool trace_group(const Octree& tree, const PacketRecordIntersector<vfloat<K>>& i
             const M in = ray_box_interval<F>(lanes[q], ray.org, ray.rdir, ray.tnear, ray.tfar, box, clip_margin, t0, t1);
             if (none(in)) continue;
             if (culled)
-                test_refs<K, AnyHit, true>(isect, leaf_refs, count, in, ray, p[q].hit, p[q].occluded, may_hit, 1u << q);
+                test_refs<K, AnyHit, true>(isect, leaf_refs, n_refs, in, ray, p[q].hit, p[q].occluded, may_hit, 1u << q);
             else
-                test_refs<K, AnyHit>(isect, leaf_refs, count, in, ray, p[q].hit, p[q].occluded);
+                test_refs<K, AnyHit>(isect, leaf_refs, n_refs, in, ray, p[q].hit, p[q].occluded);
             if constexpr (AnyHit) {
                 lanes[q] = lanes[q] & !p[q].occluded;
                 if (none(lanes[q])) live &= ~(1u << q), far_hi[q] = -inf;
