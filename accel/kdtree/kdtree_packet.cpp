@@ -105,7 +105,16 @@ RAYPACK_INLINE void test_leaf(const KdTree& tree, const PacketPrimitiveIntersect
 // The single-ray traversal of kdtree_accel.cpp lane by lane: the same
 // widened planes, so every lane visits at least the leaves its single ray
 // would, and the same kernels, so the hits are bit for bit the same. A lane
-// is active in a node while tmin <= min(tmax, tfar).
+// is active in a node while tmin <= min(tmax, tfar). With robust slabs, at
+// a leaf every lane still traced tests the primitives, also those that do
+// not reach it: a hit there is its ray's own within [tnear, tfar], and none
+// is closer than the one its single ray finds (that hit point lies in a
+// leaf the single walk visits, which holds the primitive too), while the
+// mailbox then settles each primitive for all lanes at once, so that one
+// met again in a later leaf is not tested again (shadow rays 1.04-1.10x,
+// diffuse 1.02-1.06x against the lanes that reach the leaf). Plain slabs
+// can lose a leaf that holds a single ray's closest hit, so there only the
+// lanes that reach the leaf test it, as their single rays do.
 // SameSigns: every lane in the root box has the same direction signs (all
 // camera packets but those straddling the image's centre lines), so the
 // near child is the same for all lanes (Wald's thesis, 2004, 7.1): each
@@ -220,7 +229,10 @@ void trace_packet(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>
                 if (visit_second && second_child && resume(second_lo, second_hi, second_child)) continue;
             }
         } else {
-            test_leaf<K, AnyHit>(tree, isect, nodes[current], ray, hit, tmin <= tmax, occluded, mailbox);
+            // Robust slabs: every lane still traced, not only those that
+            // reach the leaf (see above).
+            const M testing = plain ? tmin <= tmax : AnyHit ? in_box & valid : in_box;
+            test_leaf<K, AnyHit>(tree, isect, nodes[current], ray, hit, testing, occluded, mailbox);
             if constexpr (AnyHit) {
                 valid = valid & !occluded;
                 if (none(valid)) return;
@@ -257,13 +269,15 @@ inline constexpr std::uint32_t kMaxCulledPrims = 32;
 /// packet. Rounding is monotone, so the corner products (split - o) * r
 /// bound every lane's own t_split and the largest |r| its slack (as
 /// trace_packet computes them, robust slabs): a packet enters every node
-/// one of its lanes would. At a leaf each packet that reaches it clips its
-/// lanes to the leaf's cell, widened by twice the tree's margin so that
-/// every lane whose own walk reaches the leaf is among them, and tests the
-/// primitives as trace_packet does (but those whose widened boxes its
-/// bounds miss, where kMinPacketsToCull packets reach the leaf), so every
-/// lane tests at least the primitives its single ray would find and keeps
-/// the same closest hit (ties go to the lowest primitive in both).
+/// one of its lanes would. At a leaf each packet that reaches it tests the
+/// primitives with all its lanes still traced, as trace_packet does (but
+/// those whose widened boxes its bounds miss, where kMinPacketsToCull
+/// packets reach the leaf), so every lane tests at least the primitives its
+/// single ray would find and keeps the same closest hit (ties go to the
+/// lowest primitive in both). Clipping each packet's lanes to the leaf's
+/// cell first cost the clip and left the lanes outside it unsettled in the
+/// mailbox, to test the primitive again in the next leaf: camera rays
+/// 1.06-1.19x faster without it (docs/structures.md).
 /// Origins must coincide: with origins spread over a patch (shadow rays),
 /// rays nearly parallel to a split bound nothing. Robust slabs and float
 /// precision only; false (nothing traced) if the packets do not share one
@@ -337,11 +351,9 @@ bool trace_group(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>>
     };
     UnsetMailbox mailbox[G];
     for (int q = 0; q < count; ++q) mailbox[q].clear();
-    // The far children still to visit: the packets' intervals in them, and
-    // the cell (for the leaves' clips). No constructors: left unset.
+    // The far children still to visit, and the packets' intervals in them.
     struct Pending {
         std::uint32_t node, packets;
-        float lo[3], hi[3];
     };
     alignas(32) float stack_enter[kKdMaxDepth + 1][G], stack_leave[kKdMaxDepth + 1][G];
     Pending stack[kKdMaxDepth + 1];
@@ -349,7 +361,9 @@ bool trace_group(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>>
     const KdNode* nodes = tree.nodes.data();
     const PF margin(tree.margin);
     std::uint32_t current = 0, packets = live;
-    Box3f cell = tree.bounds;
+    // Primitive boxes are widened for the whole tree's reach: the leaf's own
+    // cell, kept on the stack for it, was no faster (0.99-1.03x).
+    const float pad = culling_box_pad(tree.bounds, g_lo, g_hi);
     for (;;) {
         const KdNode& node = nodes[current];
         if (!node.is_leaf()) {
@@ -382,21 +396,17 @@ bool trace_group(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>>
                 if (far && far_packets) {
                     Pending& e = stack[sp];
                     e.node = far, e.packets = far_packets;
-                    for (int b = 0; b < 3; ++b) e.lo[b] = cell.lo[b], e.hi[b] = cell.hi[b];
-                    (below_first ? e.lo : e.hi)[a] = split_pos;
                     for (int h = 0; h < H; ++h) {
                         far_lo[h].store_aligned(stack_enter[sp] + 8 * h);
                         leave[h].store_aligned(stack_leave[sp] + 8 * h);
                     }
                     ++sp;
                 }
-                (below_first ? cell.hi : cell.lo)[a] = split_pos;
                 for (int h = 0; h < H; ++h) leave[h] = near_hi[h];
                 current = near, packets = near_packets;
                 continue;
             }
             if (far && far_packets) {
-                (below_first ? cell.lo : cell.hi)[a] = split_pos;
                 for (int h = 0; h < H; ++h) enter[h] = far_lo[h];
                 current = far, packets = far_packets;
                 continue;
@@ -410,7 +420,6 @@ bool trace_group(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>>
             const bool culled = n_prims <= kMaxCulledPrims && std::popcount(packets) >= kMinPacketsToCull;
             if (culled) {
                 const std::uint32_t* prims = tree.leaf_prims(node);
-                const float pad = culling_box_pad(cell, g_lo, g_hi);
                 for (std::uint32_t k = 0; k < n_prims; ++k)
                     may_hit[k] = packets_meeting_box<G>(org, r_lo, r_hi, up, primitive_bounds(*isect.scene, prims[k]),
                                                         pad, tfar);
@@ -418,15 +427,11 @@ bool trace_group(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>>
             for (std::uint32_t b = packets; b != 0; b &= b - 1) {
                 const int q = std::countr_zero(b);
                 RayPacket<K>& ray = p[q].ray;
-                F t0, t1;
-                const M in = ray_box_interval<F>(lanes[q], ray.org, ray.rdir, ray.tnear, ray.tfar, cell,
-                                                2.0f * tree.margin, t0, t1);
-                if (none(in)) continue;
                 if (culled)
-                    test_leaf<K, AnyHit, true>(tree, isect, node, ray, p[q].hit, in, p[q].occluded, mailbox[q], may_hit,
-                                               1u << q);
+                    test_leaf<K, AnyHit, true>(tree, isect, node, ray, p[q].hit, lanes[q], p[q].occluded, mailbox[q],
+                                               may_hit, 1u << q);
                 else
-                    test_leaf<K, AnyHit>(tree, isect, node, ray, p[q].hit, in, p[q].occluded, mailbox[q]);
+                    test_leaf<K, AnyHit>(tree, isect, node, ray, p[q].hit, lanes[q], p[q].occluded, mailbox[q]);
                 if constexpr (AnyHit) {
                     lanes[q] = lanes[q] & !p[q].occluded;
                     if (none(lanes[q])) live &= ~(1u << q), t_far_now[q] = -inf;
@@ -451,8 +456,6 @@ bool trace_group(const KdTree& tree, const PacketPrimitiveIntersector<vfloat<K>>
                     enter[h] = PF::load_aligned(stack_enter[sp] + 8 * h);
                     leave[h] = PF::load_aligned(stack_leave[sp] + 8 * h);
                 }
-                cell.lo = {stack[sp].lo[0], stack[sp].lo[1], stack[sp].lo[2]};
-                cell.hi = {stack[sp].hi[0], stack[sp].hi[1], stack[sp].hi[2]};
                 break;
             }
         }
