@@ -123,14 +123,16 @@ bool walk_group(const Grid& grid, int k, GroupLanes<K, G>& lanes, VisitCell&& vi
     // vector pass over its lanes and four reductions.
     bool one_point = n > 0;
     float origin[3] = {0, 0, 0};
-    float packet_slope_lo[G][2], packet_slope_hi[G][2];
+    alignas(32) float packet_slope_lo[2][G], packet_slope_hi[2][G];
+    for (int i = 0; i < 2; ++i) std::fill(packet_slope_lo[i], packet_slope_lo[i] + G, 0.0f);
+    for (int i = 0; i < 2; ++i) std::fill(packet_slope_hi[i], packet_slope_hi[i] + G, 0.0f);
     auto packet_slopes = [&](int q) RAYPACK_INLINE_LAMBDA {
         const RayPacket<K>& ray = lanes.packet[q]->ray;
         const vmask<K> a = lanes.active[q];
         for (int i = 0; i < 2; ++i) {
             const F slope = ray.dir[axes[i]] * ray.rdir[k];
-            packet_slope_lo[q][i] = lane_min<K>(select(a, slope, inf));
-            packet_slope_hi[q][i] = lane_max<K>(select(a, slope, -inf));
+            packet_slope_lo[i][q] = lane_min<K>(select(a, slope, inf));
+            packet_slope_hi[i][q] = lane_max<K>(select(a, slope, -inf));
         }
     };
     for (int q = 0; q < n && one_point; ++q) {
@@ -158,8 +160,8 @@ bool walk_group(const Grid& grid, int k, GroupLanes<K, G>& lanes, VisitCell&& vi
                         : std::max(first_cell, lane_max<K>(select(a, start, -inf)));
         packet_slopes(q);
         for (int i = 0; i < 2; ++i) {
-            slope_lo[i] = std::min(slope_lo[i], packet_slope_lo[q][i]);
-            slope_hi[i] = std::max(slope_hi[i], packet_slope_hi[q][i]);
+            slope_lo[i] = std::min(slope_lo[i], packet_slope_lo[i][q]);
+            slope_hi[i] = std::max(slope_hi[i], packet_slope_hi[i][q]);
         }
         walking |= 1u << q;
         lane_count += std::popcount(mask_bits(a));
@@ -187,7 +189,6 @@ bool walk_group(const Grid& grid, int k, GroupLanes<K, G>& lanes, VisitCell&& vi
     // to narrow a cell's tests down to the packets whose own rectangle holds
     // it; reduced to cells only in slices with a non-empty cell.
     F packet_lo[G][2], packet_hi[G][2];
-    int packet_first[G][2], packet_last[G][2];
     // Between planes at distances d0 and d1 from the point along k, the
     // lines of slopes [s_lo, s_hi] along axis axes[i] (the lines, not the
     // segments: a superset of every lane's cells).
@@ -199,6 +200,46 @@ bool walk_group(const Grid& grid, int k, GroupLanes<K, G>& lanes, VisitCell&& vi
         const float b = o + std::max(std::max(c0, c1), std::max(c2, c3));
         const float slack = (std::fabs(o) + std::fabs(a) + std::fabs(b)) * kRelativeMargin;
         lo = a - slack, hi = b + slack;
+    };
+    // Per axis, packet by packet, the first and last cells of their
+    // rectangles (as floats: whole numbers), compared with a cell's
+    // coordinates W packets at a time.
+    constexpr int W = kWidthCompiled<8> ? 8 : 4;
+    static_assert(G % W == 0, "the packets' cell ranges are compared W at a time");
+    using PF = vfloat<W>;
+    alignas(32) float packet_first[2][G], packet_last[2][G];
+    for (int q = 0; q < G; ++q)  // packets past the group: no cells
+        packet_first[0][q] = packet_first[1][q] = 1.0f, packet_last[0][q] = packet_last[1][q] = 0.0f;
+    // The packets whose rectangle holds cell `i` along axes[x].
+    auto packets_holding = [&](int x, int i) RAYPACK_INLINE_LAMBDA {
+        const PF c = PF(float(i));
+        std::uint32_t bits = 0;
+        for (int h = 0; h < G / W; ++h)
+            bits |= mask_bits((PF::load_aligned(packet_first[x] + W * h) <= c) &
+                              (c <= PF::load_aligned(packet_last[x] + W * h)))
+                    << (W * h);
+        return bits;
+    };
+    // cell_span() for every packet from one point, W at a time.
+    auto packet_cell_spans_from_point = [&](int x) RAYPACK_INLINE_LAMBDA {
+        const int a = axes[x];
+        const PF o(origin[a]), d0(slice_d0), d1(slice_d1), rel_w(kRelativeMargin);
+        const PF grid_lo(g.bounds.lo[a]), inv_cell(g.inv_cell_size[a]), margin(kCellMargin), zero(0.0f);
+        const PF top(float(g.res[a] - 1));
+        for (int h = 0; h < G / W; ++h) {
+            const PF s_lo = PF::load_aligned(packet_slope_lo[x] + W * h);
+            const PF s_hi = PF::load_aligned(packet_slope_hi[x] + W * h);
+            const PF c0 = d0 * s_lo, c1 = d0 * s_hi, c2 = d1 * s_lo, c3 = d1 * s_hi;
+            const PF lo_p = o + vmin(vmin(c0, c1), vmin(c2, c3));
+            const PF hi_p = o + vmax(vmax(c0, c1), vmax(c2, c3));
+            const PF slack = (vabs(o) + vabs(lo_p) + vabs(hi_p)) * rel_w;
+            const PF lo_cell = (lo_p - slack - grid_lo) * inv_cell - margin;
+            const PF hi_cell = (hi_p + slack - grid_lo) * inv_cell + margin;
+            select(lo_cell > zero, select(lo_cell < top, round_down(lo_cell), top), zero)
+                .store_aligned(packet_first[x] + W * h);
+            select(hi_cell > zero, select(hi_cell < top, round_down(hi_cell), top), zero)
+                .store_aligned(packet_last[x] + W * h);
+        }
     };
     auto rectangle_from_point = [&](int i0, int i1, int first[2], int last[2], std::uint32_t& in_slice)
                                     RAYPACK_INLINE_LAMBDA {
@@ -241,19 +282,54 @@ bool walk_group(const Grid& grid, int k, GroupLanes<K, G>& lanes, VisitCell&& vi
                       g.res[axes[i]], first[i], last[i]);
         return true;
     };
+    // Lanes stop at the end of a slice once their closest hit lies before
+    // its far plane (each lane's own test, as walk()'s), but only packets
+    // that may have such a lane run it: per packet, the cell coordinate
+    // along k of its lanes' nearest end, less a cell (mirrored when going
+    // down), compared with the plane's W packets at a time. The packets
+    // tested in a slice (hits shorten their lanes) take theirs again first.
+    alignas(32) float drop_at[G];
+    std::uint32_t touched = 0;  // packets tested since the last stop_before
+    auto take_drop_at = [&](int q) RAYPACK_INLINE_LAMBDA {
+        const RayPacket<K>& ray = lanes.packet[q]->ray;
+        const vmask<K> a = lanes.active[q];
+        const F end = vmin(ray.tfar, exit[q]);
+        const F c = (ray.org[k] + ray.dir[k] * end - F(g.bounds.lo[k])) * F(g.inv_cell_size[k]);
+        drop_at[q] = up ? lane_min<K>(select(a & (c == c), c, -inf)) - 1.0f
+                        : -(lane_max<K>(select(a & (c == c), c, inf)) + 1.0f);
+    };
+    for (int q = 0; q < G; ++q) drop_at[q] = std::numeric_limits<float>::infinity();
+    for (int q = 0; q < n; ++q) take_drop_at(q);
     bool narrowed = false;  // a packet's slopes narrowed since the group's were taken
     auto stop_before = [&](int i) RAYPACK_INLINE_LAMBDA {
-        lane_count = 0;
-        for (std::uint32_t bits = walking; bits; bits &= bits - 1) {
+        bool recount = touched != 0;
+        for (std::uint32_t bits = touched & walking; bits; bits &= bits - 1) take_drop_at(std::countr_zero(bits));
+        for (std::uint32_t bits = touched & ~walking; bits; bits &= bits - 1)
+            drop_at[std::countr_zero(bits)] = std::numeric_limits<float>::infinity();
+        touched = 0;
+        const PF plane(up ? float(i) : -float(i));
+        std::uint32_t due = 0;
+        for (int h = 0; h < G / W; ++h) due |= mask_bits(PF::load_aligned(drop_at + W * h) <= plane) << (W * h);
+        for (std::uint32_t bits = due & walking; bits; bits &= bits - 1) {
             const int q = std::countr_zero(bits);
             const F t_out = plane_t(q, i);
             const F end = vmin(lanes.packet[q]->ray.tfar, exit[q]);
             const vmask<K> before = lanes.active[q];
             lanes.active[q] = before & !(end + (vabs(end) + vabs(t_out)) * rel < t_out);
             const int c = std::popcount(mask_bits(lanes.active[q]));
-            if (c == 0) walking &= ~(1u << q), narrowed = one_point;
-            else if (one_point && c != std::popcount(mask_bits(before))) packet_slopes(q), narrowed = true;
-            lane_count += c;
+            if (c == 0) {
+                walking &= ~(1u << q), narrowed = one_point;
+                drop_at[q] = std::numeric_limits<float>::infinity();
+            } else if (c != std::popcount(mask_bits(before))) {
+                if (one_point) packet_slopes(q), narrowed = true;
+                take_drop_at(q);
+            }
+            recount = true;
+        }
+        if (recount) {
+            lane_count = 0;
+            for (std::uint32_t bits = walking; bits; bits &= bits - 1)
+                lane_count += std::popcount(mask_bits(lanes.active[std::countr_zero(bits)]));
         }
         if (narrowed) {  // the group's slopes, for the rectangles from one point
             narrowed = false;
@@ -262,8 +338,8 @@ bool walk_group(const Grid& grid, int k, GroupLanes<K, G>& lanes, VisitCell&& vi
             for (std::uint32_t bits = walking; bits; bits &= bits - 1) {
                 const int q = std::countr_zero(bits);
                 for (int x = 0; x < 2; ++x) {
-                    slope_lo[x] = std::min(slope_lo[x], packet_slope_lo[q][x]);
-                    slope_hi[x] = std::max(slope_hi[x], packet_slope_hi[q][x]);
+                    slope_lo[x] = std::min(slope_lo[x], packet_slope_lo[x][q]);
+                    slope_hi[x] = std::max(slope_hi[x], packet_slope_hi[x][q]);
                 }
             }
         }
@@ -289,8 +365,6 @@ bool walk_group(const Grid& grid, int k, GroupLanes<K, G>& lanes, VisitCell&& vi
         [&](int slice, const int first[2], const int last[2]) RAYPACK_INLINE_LAMBDA {
             const std::uint32_t* row = begin + slice * stride[k] + first[1] * stride[v] + first[0] * stride[u];
             bool packet_cells = false;
-            constexpr int kMaxColumns = 64;
-            std::uint32_t in_column[kMaxColumns];
             std::uint32_t in_row = 0;
             int row_of_packets = -1;
             for (int j = first[1]; j <= last[1]; ++j, row += stride[v]) {
@@ -298,50 +372,25 @@ bool walk_group(const Grid& grid, int k, GroupLanes<K, G>& lanes, VisitCell&& vi
                 for (int i = first[0]; i <= last[0]; ++i, cell += stride[u]) {
                     if (cell[0] == cell[1]) continue;
                     if (!packet_cells) {
-                        for (std::uint32_t bits = in_slice; bits; bits &= bits - 1) {
-                            const int q = std::countr_zero(bits);
-                            for (int x = 0; x < 2; ++x) {
-                                float lo, hi;
-                                if (one_point) {
-                                    point_span(x, packet_slope_lo[q][x], packet_slope_hi[q][x], lo, hi);
-                                } else {
-                                    lo = lane_min<K>(packet_lo[q][x]);
-                                    hi = lane_max<K>(packet_hi[q][x]);
+                        if (one_point) {
+                            for (int x = 0; x < 2; ++x) packet_cell_spans_from_point(x);
+                        } else {
+                            for (std::uint32_t bits = in_slice; bits; bits &= bits - 1) {
+                                const int q = std::countr_zero(bits);
+                                for (int x = 0; x < 2; ++x) {
+                                    int c0, c1;
+                                    cell_span(lane_min<K>(packet_lo[q][x]), lane_max<K>(packet_hi[q][x]),
+                                              g.bounds.lo[axes[x]], g.inv_cell_size[axes[x]], g.res[axes[x]], c0, c1);
+                                    packet_first[x][q] = float(c0), packet_last[x][q] = float(c1);
                                 }
-                                cell_span(lo, hi, g.bounds.lo[axes[x]], g.inv_cell_size[axes[x]], g.res[axes[x]],
-                                          packet_first[q][x], packet_last[q][x]);
                             }
                         }
                         packet_cells = true;
-                        // The packets whose rectangle holds each column of
-                        // the slice's (the first kMaxColumns), and row.
-                        const int columns = std::min(last[0] - first[0] + 1, kMaxColumns);
-                        std::fill(in_column, in_column + columns, 0u);
-                        for (std::uint32_t bits = in_slice; bits; bits &= bits - 1) {
-                            const int q = std::countr_zero(bits);
-                            const int c0 = std::max(packet_first[q][0], first[0]) - first[0];
-                            const int c1 = std::min(packet_last[q][0] - first[0], columns - 1);
-                            for (int c = c0; c <= c1; ++c) in_column[c] |= 1u << q;
-                        }
                         row_of_packets = -1;
                     }
-                    if (row_of_packets != j) {
-                        row_of_packets = j;
-                        in_row = 0;
-                        for (std::uint32_t bits = in_slice; bits; bits &= bits - 1) {
-                            const int q = std::countr_zero(bits);
-                            if (packet_first[q][1] <= j && j <= packet_last[q][1]) in_row |= 1u << q;
-                        }
-                    }
-                    std::uint32_t here = 0;
-                    if (i - first[0] < kMaxColumns) {
-                        here = in_column[i - first[0]] & in_row;
-                    } else {
-                        for (std::uint32_t bits = in_row; bits; bits &= bits - 1) {
-                            const int q = std::countr_zero(bits);
-                            if (packet_first[q][0] <= i && i <= packet_last[q][0]) here |= 1u << q;
-                        }
-                    }
+                    if (row_of_packets != j) row_of_packets = j, in_row = in_slice & packets_holding(1, j);
+                    const std::uint32_t here = in_row & packets_holding(0, i);
+                    touched |= here;
                     if (visit_cell(std::uint32_t(cell - begin), here, walking)) return true;
                 }
             }
