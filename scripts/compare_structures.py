@@ -14,10 +14,15 @@ usage: scripts/compare_structures.py [--res 1024] [--repeat 5] [SCENE ...]
 --best: one row per scene, every structure at its fastest width against the
 first structure at its fastest (bvh4 at 16 is the default configuration
 for camera rays): the measure of issue 21.
+
+--rounds N: the whole bench N times over, each row's rate the median of its
+N rounds: a burst of load on a shared machine then spoils one round of a
+row, not the row's ratio.
 """
 import argparse
 import json
 import os
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -26,16 +31,24 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 RAYPACK = os.path.join(ROOT, os.environ.get("RAYPACK_BUILD_DIR", "build"), "raypack")
 
 
-def bench(scenes, accels, packets, res, repeat):
-    """Rows of raypack bench --json, keyed by (scene as given, accel, packet)."""
+def bench(scenes, accels, packets, res, repeat, rounds=1):
+    """Rows of raypack bench --json, keyed by (scene as given, accel, packet);
+    with several rounds, each row's mrays_per_s_median is the median of its
+    rounds' medians."""
+    runs = []
     with tempfile.TemporaryDirectory() as tmp:
         out = os.path.join(tmp, "bench.json")
-        subprocess.run([RAYPACK, "bench", *scenes, "--accel", ",".join(accels),
-                        "--packet", ",".join(str(k) for k in packets), "--rays", "camera", "--threads", "1",
-                        "--res", str(res), str(res), "--repeat", str(repeat), "--json", out],
-                       check=True, stdout=subprocess.DEVNULL)
-        with open(out) as f:
-            return {(r["scene_file"], r["accel"], r["packet"]): r for r in json.load(f)}
+        for _ in range(rounds):
+            subprocess.run([RAYPACK, "bench", *scenes, "--accel", ",".join(accels),
+                            "--packet", ",".join(str(k) for k in packets), "--rays", "camera", "--threads", "1",
+                            "--res", str(res), str(res), "--repeat", str(repeat), "--json", out],
+                           check=True, stdout=subprocess.DEVNULL)
+            with open(out) as f:
+                runs.append({(r["scene_file"], r["accel"], r["packet"]): r for r in json.load(f)})
+    rows = runs[0]
+    for key, row in rows.items():
+        row["mrays_per_s_median"] = statistics.median(run[key]["mrays_per_s_median"] for run in runs)
+    return rows
 
 
 def main():
@@ -44,6 +57,7 @@ def main():
                                                     "scenes/tree.nff", "gen:balls:4"])
     ap.add_argument("--res", type=int, default=1024)
     ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--rounds", type=int, default=1, help="whole bench runs; each row the median of its rounds")
     ap.add_argument("--accels", default="bvh2,grid,octree,kdtree")
     ap.add_argument("--packets", default="1,8,16")
     ap.add_argument("--best", action="store_true", help="each structure at its fastest width")
@@ -69,7 +83,9 @@ def table_head(args, accels, packets, first_columns, rate_suffix):
           " | ".join(f"{a}/{accels[0]}" for a in accels[1:]) + " |")
     print("|---" * (len(first_columns) + 2 * len(accels) - 1) + "|")
     paths = [scene if scene.startswith("gen:") else os.path.join(ROOT, scene) for scene in args.scenes]
-    return paths, bench(paths, accels, packets, args.res, args.repeat)
+    if args.rounds < 1:
+        sys.exit("compare_structures.py: --rounds must be at least 1")
+    return paths, bench(paths, accels, packets, args.res, args.repeat, args.rounds)
 
 
 def print_best(args, accels, packets):

@@ -92,11 +92,13 @@ int group_major_axis(const GroupLanes<K, G>& lanes) {
 
 /// walk() for a group: the major axis k and its sign are shared by every
 /// active lane of every packet (the caller checks). `visit_cell(c, packets,
-/// walking)` tests cell c against the packets of the bit set `packets`
-/// (those whose own rectangle in the slice holds the cell), clears in
-/// `walking` the packets left without lanes, and returns true once none is. Returns true when the group is done; false
-/// when its rays spread too far apart, with each packet's active lanes and
-/// entries set for it to go on alone.
+/// walking, changed)` tests cell c against the packets of the bit set
+/// `packets` (those whose own rectangle in the slice holds the cell), adds
+/// to `changed` those whose lanes found closer hits or stopped, clears in
+/// `walking` the packets left without lanes, and returns true once none is.
+/// Returns true when the group is done; false when its rays spread too far
+/// apart, with each packet's active lanes and entries set for it to go on
+/// alone.
 template <int K, int G, class VisitCell>
 bool walk_group(const Grid& grid, int k, GroupLanes<K, G>& lanes, VisitCell&& visit_cell) {
     using F = vfloat<K>;
@@ -287,9 +289,9 @@ bool walk_group(const Grid& grid, int k, GroupLanes<K, G>& lanes, VisitCell&& vi
     // that may have such a lane run it: per packet, the cell coordinate
     // along k of its lanes' nearest end, less a cell (mirrored when going
     // down), compared with the plane's W packets at a time. The packets
-    // tested in a slice (hits shorten their lanes) take theirs again first.
+    // whose lanes changed in the slice (closer hits) take theirs again first.
     alignas(32) float drop_at[G];
-    std::uint32_t touched = 0;  // packets tested since the last stop_before
+    std::uint32_t touched = 0;  // packets whose lanes changed since the last stop_before
     auto take_drop_at = [&](int q) RAYPACK_INLINE_LAMBDA {
         const RayPacket<K>& ray = lanes.packet[q]->ray;
         const vmask<K> a = lanes.active[q];
@@ -390,8 +392,7 @@ bool walk_group(const Grid& grid, int k, GroupLanes<K, G>& lanes, VisitCell&& vi
                     }
                     if (row_of_packets != j) row_of_packets = j, in_row = in_slice & packets_holding(1, j);
                     const std::uint32_t here = in_row & packets_holding(0, i);
-                    touched |= here;
-                    if (visit_cell(std::uint32_t(cell - begin), here, walking)) return true;
+                    if (visit_cell(std::uint32_t(cell - begin), here, walking, touched)) return true;
                 }
             }
             return false;
@@ -408,8 +409,9 @@ bool trace_group(const Grid& grid, const PacketRecordIntersector<vfloat<K>>& ise
     GroupMailbox mailbox;
     const std::uint32_t* begin = grid.cell_begin.data();
     const std::uint32_t* refs = grid.refs.data();
-    return walk_group<K, G>(grid, k, lanes, [&](std::uint32_t c, std::uint32_t packets, std::uint32_t& walking)
-                                                RAYPACK_INLINE_LAMBDA {
+    return walk_group<K, G>(grid, k, lanes,
+                            [&](std::uint32_t c, std::uint32_t packets, std::uint32_t& walking,
+                                std::uint32_t& changed) RAYPACK_INLINE_LAMBDA {
         for (std::uint32_t r = begin[c], r_end = begin[c + 1]; r < r_end; ++r) {
             const std::uint32_t prim = refs[r];
             std::uint32_t& tested = mailbox.tested(prim);
@@ -419,14 +421,14 @@ bool trace_group(const Grid& grid, const PacketRecordIntersector<vfloat<K>>& ise
                 const int q = std::countr_zero(bits);
                 LoadedPacket<K>& p = *lanes.packet[q];
                 const vmask<K> m = isect.intersect(lanes.active[q], p.ray, p.hit, prim);
+                if (!any(m)) continue;
+                changed |= 1u << q;
                 if constexpr (AnyHit) {
-                    if (any(m)) {
-                        p.occluded = p.occluded | m;
-                        lanes.active[q] = lanes.active[q] & !m;
-                        if (none(lanes.active[q])) {
-                            walking &= ~(1u << q);
-                            if (walking == 0) return true;
-                        }
+                    p.occluded = p.occluded | m;
+                    lanes.active[q] = lanes.active[q] & !m;
+                    if (none(lanes.active[q])) {
+                        walking &= ~(1u << q);
+                        if (walking == 0) return true;
                     }
                 }
             }

@@ -292,7 +292,9 @@ void Grid2Accel::trace_packets(int width, std::span<const Rayf> rays, std::span<
                     const int k = lanes.count > 1 ? coherent_grid::group_major_axis<K, G>(lanes) : -1;
                     if (k >= 0 && coherent_grid::walk_group<K, G>(
                                       grid_.top, k, lanes,
-                                      [&](std::uint32_t c, std::uint32_t here, std::uint32_t& walking) {
+                                      [&](std::uint32_t c, std::uint32_t here, std::uint32_t& walking,
+                                          std::uint32_t& changed) {
+                                          changed |= here;  // as far as this walk knows
                                           return visit_top_cell_group<K, G, AnyHit, Slabs>(isect, k, c, here,
                                                                                            walking, lanes);
                                       }))
