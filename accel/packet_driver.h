@@ -121,16 +121,19 @@ void trace_in_packets(std::span<const Rayf> rays, std::span<Hitf> hits, RcpMetho
 }
 
 /// The same in groups of up to G consecutive packets (G * K rays):
-/// `trace_group(packets, count)` traces `count` loaded packets together. A
-/// packet for which `may_lead(packet)` is false cannot start a group (its
-/// rays are not coherent enough to share a walk): it is traced alone with
-/// `trace_packet`, without waiting for the packets after it.
-template <int K, int G, bool AnyHit, class MayLead, class TracePacket, class TraceGroup>
-void trace_in_groups(std::span<const Rayf> rays, std::span<Hitf> hits, RcpMethod rcp, MayLead&& may_lead,
-                     TracePacket&& trace_packet, TraceGroup&& trace_group) {
+/// `trace_group(packets, count)` traces `count` loaded packets together.
+/// `group_size(packet)` says how many packets a group led by `packet` may
+/// hold, at most G (a walk may want fewer packets of some rays: the grid's
+/// groups of rays from several points); a packet for which it is 0 cannot
+/// start a group (its rays are not coherent enough to share a walk):
+/// it is traced alone with `trace_packet`, without waiting for the packets
+/// after it.
+template <int K, int G, bool AnyHit, class GroupSize, class TracePacket, class TraceGroup>
+void trace_in_sized_groups(std::span<const Rayf> rays, std::span<Hitf> hits, RcpMethod rcp, GroupSize&& group_size,
+                           TracePacket&& trace_packet, TraceGroup&& trace_group) {
     LoadedPacket<K> p[G];
     std::size_t group_first = 0;
-    int count = 0;
+    int count = 0, size = G;
     auto flush = [&] {
         trace_group(p, count);
         for (int g = 0; g < count; ++g)
@@ -138,27 +141,38 @@ void trace_in_groups(std::span<const Rayf> rays, std::span<Hitf> hits, RcpMethod
         count = 0;
     };
     for (std::size_t first = 0; first < rays.size(); first += K) {
-        // A group loads G packets at once and then walks for long without
+        // A group loads its packets at once and then walks for long without
         // touching the stream, so the hardware prefetcher, which follows a
         // stream a few lines ahead of its misses, falls behind (on Zen 5 a
         // third of a group walk's time went into loading rays from a large
         // array). Each packet loaded asks for its place in the next group,
         // and for its own hits, which are stored after the walk.
-        prefetch_elements<false>(rays, first + G * K, K);
+        prefetch_elements<false>(rays, first + std::size_t(size) * K, K);
         prefetch_elements<true>(hits, first, K);
         LoadedPacket<K>& next = p[count];
         load_fresh_packet<K>(rays, first, rcp, next);
         if (count == 0) {
-            if (!may_lead(next)) {
+            size = std::min(G, group_size(next));
+            if (size < 1) {
+                size = G;
                 trace_packet(next.ray, next.hit, next.valid, next.occluded);
                 store_packet<K, AnyHit>(next.hit, next.occluded, hits, first, next.n);
                 continue;
             }
             group_first = first;
         }
-        if (++count == G) flush();
+        if (++count == size) flush();
     }
     if (count != 0) flush();
+}
+
+/// trace_in_sized_groups with groups of G packets, where `may_lead(packet)`
+/// says whether a packet may start one.
+template <int K, int G, bool AnyHit, class MayLead, class TracePacket, class TraceGroup>
+void trace_in_groups(std::span<const Rayf> rays, std::span<Hitf> hits, RcpMethod rcp, MayLead&& may_lead,
+                     TracePacket&& trace_packet, TraceGroup&& trace_group) {
+    trace_in_sized_groups<K, G, AnyHit>(
+        rays, hits, rcp, [&](const LoadedPacket<K>& p) { return may_lead(p) ? G : 0; }, trace_packet, trace_group);
 }
 
 /// trace_in_groups for walks that may decline a group: `trace_group(packets,

@@ -1,7 +1,9 @@
 #include "accel/grid/grid_packet.h"
 
+#include <algorithm>
 #include <bit>
 #include <limits>
+#include <type_traits>
 
 #include "accel/cell_kernel_variants.h"
 #include "accel/grid/coherent_grid.h"
@@ -51,24 +53,41 @@ void grid_trace_packets(const Grid& grid, const Scene& scene, KernelChoice kerne
             trace_in_packets<K, AnyHit>(rays, hits, kernels.rcp, trace_one);
             return;
         }
-        constexpr int G = coherent_grid::kGroupRays / K;
-        static_assert(G >= 2 && G <= 32, "a group's packets are bits of a 32-bit word");
-        trace_in_groups_or_alone<K, G, AnyHit>(
-            rays, hits, kernels.rcp, [](const LoadedPacket<K>&) { return true; }, trace_one,
+        // Rays from several points walk in smaller groups than rays from
+        // one point, each group a walk sized for it (the work per slice
+        // grows with G).
+        constexpr int G = coherent_grid::kOnePointGroupPackets<K>;
+        constexpr int kSpreadGroup = coherent_grid::kGroupRays / K;
+        static_assert(G >= 2 && G <= 32 && kSpreadGroup >= 2 && kSpreadGroup <= G,
+                      "a group's packets are bits of a 32-bit word");
+        auto trace_group = [&]<int GG>(std::integral_constant<int, GG>, LoadedPacket<K>* p, int count) {
+            coherent_grid::GroupLanes<K, GG> lanes;
+            coherent_grid::enter_group<K, GG, Slabs>(grid, p, count, lanes);
+            const int k = lanes.count > 1 ? coherent_grid::group_major_axis<K, GG>(lanes) : -1;
+            if (k >= 0 && coherent_grid::trace_group<K, GG, AnyHit>(grid, isect, k, lanes)) return;
+            for (int q = 0; q < lanes.count; ++q) {
+                LoadedPacket<K>& one = *lanes.packet[q];
+                if (any(lanes.active[q])) go_on_alone(one.ray, one.hit, lanes.active[q], lanes.entry[q], one.occluded);
+            }
+        };
+        // A group led by a packet from one point (camera rays) holds G
+        // packets; others kSpreadGroup (their walks split a group that does
+        // not leave one point, all the same).
+        trace_in_sized_groups<K, G, AnyHit>(
+            rays, hits, kernels.rcp, [](const LoadedPacket<K>& p) { return one_origin<K>(p) ? G : kSpreadGroup; },
+            trace_one,
             [&](LoadedPacket<K>* p, int count) {
+                if (count == 1) return trace_one(p[0].ray, p[0].hit, p[0].valid, p[0].occluded);
                 for (int q = 0; q < count; ++q)
                     intersect_outside<K, AnyHit>(grid.outside, isect, p[q].ray, p[q].hit, p[q].valid, p[q].occluded);
-                if (grid.empty()) return true;
-                coherent_grid::GroupLanes<K, G> lanes;
-                coherent_grid::enter_group<K, G, Slabs>(grid, p, count, lanes);
-                const int k = lanes.count > 1 ? coherent_grid::group_major_axis<K, G>(lanes) : -1;
-                if (k >= 0 && coherent_grid::trace_group<K, G, AnyHit>(grid, isect, k, lanes)) return true;
-                for (int q = 0; q < lanes.count; ++q) {
-                    LoadedPacket<K>& one = *lanes.packet[q];
-                    if (any(lanes.active[q]))
-                        go_on_alone(one.ray, one.hit, lanes.active[q], lanes.entry[q], one.occluded);
+                if (grid.empty()) return;
+                if (coherent_grid::from_one_point<K>(p, count)) {
+                    trace_group(std::integral_constant<int, G>{}, p, count);
+                } else {
+                    for (int q = 0; q < count; q += kSpreadGroup)
+                        trace_group(std::integral_constant<int, kSpreadGroup>{}, p + q,
+                                    std::min(kSpreadGroup, count - q));
                 }
-                return true;
             });
     });
 }
