@@ -52,7 +52,7 @@ struct AccelConfig {
     /// bvh4, bvh8: packets that share one walk (accel/bvh/wide_group_traversal.h);
     /// 0: the default (default_wide_packet_config), 1: each packet alone.
     /// kdtree, octree: 1 makes each packet walk alone (their groups have a
-    /// fixed size, kKdGroupPackets and kOctreeGroupPackets).
+    /// fixed size, kKdGroupPackets and octree_group_packets(K)).
     int packet_group = 0;
 };
 

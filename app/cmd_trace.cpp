@@ -120,7 +120,7 @@ int run_trace(const Args& args) {
                            packet > 1 && config.packet_group != 1 && config.kernels.precision == Precision::Float;
         j["group"] = wide    ? (config.packet_group > 0 ? config.packet_group
                                                         : default_wide_packet_config(4, packet).group_packets)
-                     : cells ? (as.name == "kdtree" ? kKdGroupPackets : kOctreeGroupPackets)
+                     : cells ? (as.name == "kdtree" ? kKdGroupPackets : octree_group_packets(packet))
                              : 1;
         j["triangle"] = triangle_method_name(config.kernels.triangle);
         j["sphere"] = sphere_method_name(config.kernels.sphere);

@@ -218,13 +218,25 @@ constexpr float kClipBelow = 1.0f / 64.0f;
 /// deepest leaves hold more than 8): tetra 1.047x, mount 1.030x, balls
 /// 1.028x, gears 1.007x, teapot 0.984x; 128: as 64.
 constexpr int kMinPacketsToCull = 2;
+
+/// A packet whose rays' reciprocal directions differ by more than this
+/// factor along an axis walks alone, not in a group: its rays are nearly
+/// parallel to a plane of the axes (next to the border of the octant, on
+/// camera rays across the image's middle), and its bounds, by intervals of
+/// those reciprocals carried down the tree by midpoints, stay as loose in
+/// small nodes as at the root, admitting far more nodes than its rays
+/// reach. Camera rays 1024 x 1024, groups of 16 packets, against no such
+/// rule: gears 1.33x, teapot 0.96x, tetra 0.975x; among 1.1 to 2, 1.25 was
+/// best on gears (1.5: 0.97x of it, 1.1: tetra 0.98x).
+constexpr float kMaxReciprocalSpread = 1.25f;
 constexpr std::uint32_t kMaxCulledRefs = 64;
 
 /// A node of the group walk: per packet (in lanes), bounds of its lanes'
 /// slab parameters, by half as in PacketFrame: lo_* bound every lane's from
 /// below, hi_* from above.
+template <int G>
 struct GroupFrame {
-    using PF = vfloat<8>;
+    using PF = vfloat<G>;
     PF lo_enter[3][2], lo_leave[3][2], hi_enter[3][2], hi_leave[3][2];
     std::uint32_t packets;  ///< the packets that entered the node
     std::uint32_t children;
@@ -267,7 +279,7 @@ RAYPACK_INLINE int packet_octant(const LoadedPacket<K>& p) {
     return a;
 }
 
-// Up to kOctreeGroupPackets packets whose rays share one direction octant
+// Up to G packets whose rays share one direction octant
 // walk the tree together (large packets: Reshetov, Soupikov & Hurley,
 // SIGGRAPH 2005; Wald's thesis, 2004), one walk for all of them where each
 // packet walks alone. A packet stands for its lanes by the smallest and
@@ -284,28 +296,31 @@ RAYPACK_INLINE int packet_octant(const LoadedPacket<K>& p) {
 // the lanes left test the leaf's primitives: each lane tests at least the
 // primitives its single ray does and, under the tie rule, keeps the same
 // closest hit. Children are taken in ascending mirrored order, front to
-// back for every lane of every packet. Returns false, tracing nothing, if
-// the packets do not share one octant.
-template <int K, bool AnyHit, SlabMethod Slabs>
-bool trace_group(const Octree& tree, const PacketRecordIntersector<vfloat<K>>& isect, LoadedPacket<K>* p,
-                 int count) {
+// back for every lane of every packet. Returns the packets it leaves to
+// walk alone: those not of the first packet's octant, not from one point,
+// or whose rays' reciprocal directions spread too far apart
+// (kMaxReciprocalSpread).
+template <int K, int G, bool AnyHit, SlabMethod Slabs>
+std::uint32_t trace_group(const Octree& tree, const PacketRecordIntersector<vfloat<K>>& isect, LoadedPacket<K>* p,
+                          int count) {
     using F = vfloat<K>;
     using M = vmask<K>;
-    using PF = vfloat<8>;
-    constexpr int G = kOctreeGroupPackets;
+    using PF = vfloat<G>;  // one lane per packet
     constexpr float inf = std::numeric_limits<float>::infinity();
     int a = -1;
+    std::uint32_t alone = 0;
     for (int q = 0; q < count; ++q) {
         const int octant = packet_octant<K>(p[q]);
-        if (octant < 0 || (a >= 0 && octant != a)) return false;
-        a = octant;
+        if (octant < 0 || (a >= 0 && octant != a)) alone |= 1u << q;
+        else a = octant;
     }
+    if (a < 0) return alone;
     const OctreeNode* nodes = tree.nodes.data();
     const std::uint32_t* refs = tree.refs.data();
-    alignas(32) float t0_lo[3][G], t0_hi[3][G], t1_lo[3][G], t1_hi[3][G], near_lo[G], far_hi[G];
+    alignas(64) float t0_lo[3][G], t0_hi[3][G], t1_lo[3][G], t1_hi[3][G], near_lo[G], far_hi[G];
     // Per packet, for culling a leaf's primitives by their boxes: its rays'
     // origin and reciprocal directions' bounds (packets_meeting_box).
-    alignas(32) float org[3][G], r_lo[3][G], r_hi[3][G];
+    alignas(64) float org[3][G], r_lo[3][G], r_hi[3][G];
     float g_lo[3] = {inf, inf, inf}, g_hi[3] = {-inf, -inf, -inf};  // every packet's origin (culling_box_pad)
     std::uint32_t up = 0;
     for (int k = 0; k < 3; ++k) up |= a & (4 >> k) ? 0u : 1u << k;
@@ -317,7 +332,7 @@ bool trace_group(const Octree& tree, const PacketRecordIntersector<vfloat<K>>& i
         near_lo[q] = inf, far_hi[q] = -inf;  // a packet that enters nothing
         for (int k = 0; k < 3; ++k)
             t0_lo[k][q] = t0_hi[k][q] = t1_lo[k][q] = t1_hi[k][q] = org[k][q] = r_lo[k][q] = r_hi[k][q] = 0.0f;
-        if (q >= count) continue;
+        if (q >= count || ((alone >> q) & 1u)) continue;
         const RayPacket<K>& ray = p[q].ray;
         F t0[3], t1[3];
         for (int k = 0; k < 3; ++k) {  // as walk() computes them
@@ -331,8 +346,29 @@ bool trace_group(const Octree& tree, const PacketRecordIntersector<vfloat<K>>& i
         const M in = p[q].valid & (vmax(max3(t0[0], t0[1], t0[2]), ray.tnear) <= vmin(min3(t1[0], t1[1], t1[2]), ray.tfar));
         lanes[q] = in;
         if (none(in)) continue;
-        live |= 1u << q;
         const F big(inf);
+        const int first = std::countr_zero(mask_bits(in)) & (K - 1);  // `in` has a lane
+        bool own_walk = false;
+        for (int k = 0; k < 3; ++k) {
+            const F o = ray.org[k], r = ray.rdir[k];
+            // Every packet's rays leave one point, not only the group's
+            // first: packets_meeting_box culls by one origin per packet.
+            org[k][q] = lane(o, first);
+            own_walk = own_walk || (mask_bits(o != F(org[k][q])) & mask_bits(in)) != 0;
+            r_lo[k][q] = lane_min<K>(select(in, r, big));
+            r_hi[k][q] = lane_max<K>(select(in, r, -big));
+            // Rays nearly parallel to a plane of the axes: reciprocals of
+            // one sign spread far apart (kMaxReciprocalSpread).
+            const float r_near = std::min(std::fabs(r_lo[k][q]), std::fabs(r_hi[k][q]));
+            own_walk = own_walk || std::max(std::fabs(r_lo[k][q]), std::fabs(r_hi[k][q])) > kMaxReciprocalSpread * r_near;
+        }
+        if (own_walk) {  // out of the group: entering nothing, walking alone
+            alone |= 1u << q;
+            lanes[q] = in & !in;
+            for (int k = 0; k < 3; ++k) org[k][q] = r_lo[k][q] = r_hi[k][q] = 0.0f;
+            continue;
+        }
+        live |= 1u << q;
         for (int k = 0; k < 3; ++k) {
             t0_lo[k][q] = lane_min<K>(select(in, t0[k], big));
             t0_hi[k][q] = lane_max<K>(select(in, t0[k], -big));
@@ -341,21 +377,14 @@ bool trace_group(const Octree& tree, const PacketRecordIntersector<vfloat<K>>& i
         }
         near_lo[q] = lane_min<K>(select(in, ray.tnear, big));
         far_hi[q] = lane_max<K>(select(in, ray.tfar, -big));
-        const int first = std::countr_zero(mask_bits(in));
         for (int k = 0; k < 3; ++k) {
             const F o = ray.org[k], r = ray.rdir[k];
             non_finite = non_finite + select(in, (o - o) + (r - r), F(0.0f));
-            // Every packet's rays leave one point, not only the group's
-            // first: packets_meeting_box culls by one origin per packet.
-            org[k][q] = lane(o, first);
-            if (mask_bits(o != F(org[k][q])) & mask_bits(in)) return false;
-            r_lo[k][q] = lane_min<K>(select(in, r, big));
-            r_hi[k][q] = lane_max<K>(select(in, r, -big));
             g_lo[k] = std::min(g_lo[k], org[k][q]);
             g_hi[k] = std::max(g_hi[k], org[k][q]);
         }
     }
-    if (live == 0) return true;
+    if (live == 0) return alone;
     struct UnsetMailbox : PacketMailbox {
         UnsetMailbox() : PacketMailbox(Unset{}) {}
     };
@@ -389,7 +418,8 @@ bool trace_group(const Octree& tree, const PacketRecordIntersector<vfloat<K>>& i
         const bool culled = cull && n_refs <= kMaxCulledRefs && std::popcount(packets) >= kMinPacketsToCull;
         if (culled) {
             const float pad = culling_box_pad(box, g_lo, g_hi);
-            const PF tf[1] = {tfar};
+            vfloat<8> tf[G / 8];  // packets_meeting_box takes the packets eight at a time
+            for (int h = 0; h < G / 8; ++h) tf[h] = vfloat<8>::load_aligned(far_hi + 8 * h);
             for (std::uint32_t k = 0; k < n_refs; ++k)
                 may_hit[k] = packets_meeting_box<G>(org, r_lo, r_hi, up, leaf_boxes[k], pad, tf);
         }
@@ -429,10 +459,10 @@ bool trace_group(const Octree& tree, const PacketRecordIntersector<vfloat<K>>& i
                   packets);
         return true;
     };
-    if (test_node(0, tree.cube, live)) return true;
-    GroupFrame stack[kOctreeMaxDepth + 1];
+    if (test_node(0, tree.cube, live)) return alone;
+    GroupFrame<G> stack[kOctreeMaxDepth + 1];
     int sp = 0;
-    GroupFrame* f = &stack[0];
+    GroupFrame<G>* f = &stack[0];
     for (int k = 0; k < 3; ++k) f->corner[k] = tree.cube.lo[k];
     f->half = 0.5f * (tree.cube.hi[0] - tree.cube.lo[0]);  // a cube (octree_cube)
     for (int k = 0; k < 3; ++k)
@@ -443,7 +473,7 @@ bool trace_group(const Octree& tree, const PacketRecordIntersector<vfloat<K>>& i
     f->left = mirrored_children(nodes[0].occupied(), unsigned(a));
     for (;;) {
         if (f->left == 0) {
-            if (sp == 0) return true;
+            if (sp == 0) return alone;
             f = &stack[--sp];
             continue;
         }
@@ -462,7 +492,7 @@ bool trace_group(const Octree& tree, const PacketRecordIntersector<vfloat<K>>& i
         const unsigned real = unsigned(c) ^ unsigned(a);
         if (test_node(index, f->child_box(real), packets)) {
             if constexpr (AnyHit)
-                if (live == 0) return true;
+                if (live == 0) return alone;
             continue;
         }
         const OctreeNode node = nodes[index];
@@ -479,7 +509,7 @@ bool trace_group(const Octree& tree, const PacketRecordIntersector<vfloat<K>>& i
             }
             if (clipped == 0) continue;
         }
-        GroupFrame* g = &stack[++sp];
+        GroupFrame<G>* g = &stack[++sp];
         for (int k = 0; k < 3; ++k) g->corner[k] = box.lo[k];
         g->half = 0.5f * f->half;
         const PF* lo_leave = &f->lo_leave[0][0];
@@ -517,22 +547,27 @@ void octree_trace_packets(const Octree& tree, const Scene& scene, KernelChoice k
             walk_one(ray, hit, valid, occluded);
         };
 #if defined(__AVX2__)
-        static_assert(kOctreeGroupPackets == 8, "trace_group: one lane of a vfloat<8> per packet");
+        constexpr int G = octree_group_packets(K);
+        static_assert(G % 8 == 0 && kWidthCompiled<G>, "trace_group: one lane of a vfloat<G> per packet");
         // Packets from one point and of one direction octant walk in groups
         // (trace_group); packets of spread origins (shadow rays from a tile's
         // surface points) ran 1.2-2.3x faster alone on tetra, teapot and
         // gears. The tie rule needs float tests (the double ones go lane by lane).
         if (groups && kernels.precision == Precision::Float) {
-            trace_in_groups_or_alone<K, kOctreeGroupPackets, AnyHit>(
+            trace_in_groups<K, G, AnyHit>(
                 rays, hits, kernels.rcp,
                 [](const LoadedPacket<K>& p) { return packet_octant<K>(p) >= 0 && one_origin<K>(p); }, trace_one,
                 [&](LoadedPacket<K>* p, int count) {
+                    if (count == 1) return trace_one(p[0].ray, p[0].hit, p[0].valid, p[0].occluded);
                     for (int q = 0; q < count; ++q)
                         intersect_outside<K, AnyHit>(tree.outside, isect, p[q].ray, p[q].hit, p[q].valid,
                                                      p[q].occluded);
-                    if (tree.empty() || trace_group<K, AnyHit, Slabs>(tree, isect, p, count)) return true;
-                    for (int q = 0; q < count; ++q) walk_one(p[q].ray, p[q].hit, p[q].valid, p[q].occluded);
-                    return true;
+                    if (tree.empty()) return;
+                    for (std::uint32_t alone = trace_group<K, G, AnyHit, Slabs>(tree, isect, p, count); alone != 0;
+                         alone &= alone - 1) {
+                        LoadedPacket<K>& one = p[std::countr_zero(alone)];
+                        walk_one(one.ray, one.hit, one.valid, one.occluded);
+                    }
                 });
             return;
         }
