@@ -92,12 +92,9 @@ RAYPACK_INLINE void test_leaf(const KdTree& tree, const PacketPrimitiveIntersect
             if (any(tie)) [[unlikely]]
                 keep_lowest_on_ties<K>(tie, before, hit, prims[k]);
         } else {
-            const HitPacket<K> before = hit;
-            const M m = isect.intersect(active, ray, hit, prims[k]);
-            // Equal t: the lowest primitive number wins, as in the single-ray path.
-            const M tie = m & (hit.t == before.t);
-            if (ties_another_primitive<K>(mask_bits(tie), before, prims[k])) [[unlikely]]
-                keep_lowest_on_ties<K>(tie, before, hit, prims[k]);
+            // Equal t: the lowest primitive number wins, as in the single-ray
+            // path (checked before the hit is recorded: no copy of the hits).
+            intersect_keeping_lowest<K>(isect, active, ray, hit, prims[k]);
         }
     }
 }
