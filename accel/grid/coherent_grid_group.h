@@ -30,14 +30,14 @@ namespace raypack::coherent_grid {
 
 /// Rays per group of coherent packets: 128 rays (8 packets of 16, two 8 x 8
 /// tiles of `raypack rays`) traced camera and shadow rays as fast as 256 and
-/// up to 1.08x as fast as 64 (session 22).
+/// up to 1.08x as fast as 64 (docs/structures.md).
 inline constexpr int kGroupRays = 128;
 
 /// Packets per group of packets of K rays from one point (camera rays): in
 /// packets of 16, 32 (512 rays, the most a 32-bit set of packets holds),
 /// since a slice's work for the packets (their cell ranges, their ends) is
-/// done eight packets at a time: camera rays 1.02-1.13x as fast as in
-/// groups of 128 rays, while shadow rays lost 3-4% in groups of 512; in
+/// done eight packets at a time: camera rays 1.01-1.11x as fast as in
+/// groups of 128 rays, while shadow rays lost 3-6% in groups of 512; in
 /// packets of 8, 256 rays were 0.94-0.99x as fast as 128 (docs/structures.md).
 template <int K>
 inline constexpr int kOnePointGroupPackets = K == 16 ? 32 : kGroupRays / K;
@@ -45,13 +45,11 @@ inline constexpr int kOnePointGroupPackets = K == 16 ? 32 : kGroupRays / K;
 /// Whether the valid lanes of the packets p[0, count) all leave one point.
 template <int K>
 bool from_one_point(const LoadedPacket<K>* p, int count) {
-    int first = -1;
     for (int q = 0; q < count; ++q) {
-        if (!one_origin<K>(p[q])) return false;
-        if (first < 0) first = q;
+        if (!one_origin<K>(p[q])) return false;  // also false without a valid lane
         for (int a = 0; a < 3; ++a)
             if (lane(p[q].ray.org[a], std::countr_zero(mask_bits(p[q].valid))) !=
-                lane(p[first].ray.org[a], std::countr_zero(mask_bits(p[first].valid))))
+                lane(p[0].ray.org[a], std::countr_zero(mask_bits(p[0].valid))))
                 return false;
     }
     return true;

@@ -74,7 +74,7 @@ void grid_trace_packets(const Grid& grid, const Scene& scene, KernelChoice kerne
         // packets; others kSpreadGroup (their walks split a group that does
         // not leave one point, all the same).
         trace_in_sized_groups<K, G, AnyHit>(
-            rays, hits, kernels.rcp, [](const LoadedPacket<K>& p) { return one_origin<K>(p) ? G : kSpreadGroup; },
+            rays, hits, kernels.rcp, [&](const LoadedPacket<K>& p) { return one_origin<K>(p) ? G : kSpreadGroup; },
             trace_one,
             [&](LoadedPacket<K>* p, int count) {
                 if (count == 1) return trace_one(p[0].ray, p[0].hit, p[0].valid, p[0].occluded);

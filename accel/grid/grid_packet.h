@@ -1,7 +1,8 @@
 #pragma once
 // Packet traversal of the uniform grid. Consecutive packets whose rays share
 // a major direction walk the grid slice by slice, in groups of 128 rays
-// (coherent_grid_group.h, Wald et al. 2006), or a packet at once
+// (512 rays from one point in packets of 16; coherent_grid_group.h, Wald et
+// al. 2006), or a packet at once
 // (coherent_grid.h). Other packets step each lane's own 3D-DDA
 // (dda_packet.h): lanes in empty cells step together, and a cell with
 // references is tested once, with the packet kernels, for all the lanes that

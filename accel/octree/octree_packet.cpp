@@ -218,6 +218,7 @@ constexpr float kClipBelow = 1.0f / 64.0f;
 /// deepest leaves hold more than 8): tetra 1.047x, mount 1.030x, balls
 /// 1.028x, gears 1.007x, teapot 0.984x; 128: as 64.
 constexpr int kMinPacketsToCull = 2;
+constexpr std::uint32_t kMaxCulledRefs = 64;
 
 /// A packet whose rays' reciprocal directions differ by more than this
 /// factor along an axis walks alone, not in a group: its rays are nearly
@@ -229,7 +230,6 @@ constexpr int kMinPacketsToCull = 2;
 /// rule: gears 1.33x, teapot 0.96x, tetra 0.975x; among 1.1 to 2, 1.25 was
 /// best on gears (1.5: 0.97x of it, 1.1: tetra 0.98x).
 constexpr float kMaxReciprocalSpread = 1.25f;
-constexpr std::uint32_t kMaxCulledRefs = 64;
 
 /// A node of the group walk: per packet (in lanes), bounds of its lanes'
 /// slab parameters, by half as in PacketFrame: lo_* bound every lane's from
