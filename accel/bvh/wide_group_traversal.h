@@ -164,8 +164,8 @@ RAYPACK_INLINE std::uint32_t group_child_candidates(const WideNode<N>& node, con
 
 /// The boxes of a block's primitives, slot by slot, for the kinds that
 /// have a cheap one: triangles (their three vertices; with Moeller's test
-/// the block holds p0, p0 - p1 and p2 - p0, else the vertices) and spheres.
-/// False for the other kinds, whose primitives are all kept.
+/// the block holds p0, p0 - p1 and p2 - p0, else the vertices), spheres and
+/// cones. False for the other kinds, whose primitives are all kept.
 template <class Kind, TriangleMethod TM, class Block, int M = int(sizeof(Block::prim) / sizeof(Block::prim[0]))>
 RAYPACK_INLINE bool slot_boxes(const Block& b, vfloat<M> (&lo)[3], vfloat<M> (&hi)[3]) {
     using V = vfloat<M>;
@@ -183,6 +183,22 @@ RAYPACK_INLINE bool slot_boxes(const Block& b, vfloat<M> (&lo)[3], vfloat<M> (&h
             const V c = V::load_unaligned(b.center[a]);
             lo[a] = c - r;
             hi[a] = c + r;
+        }
+        return true;
+    } else if constexpr (Kind::kind == PrimKind::Cone) {
+        // The box of the end discs: the surface between them is their
+        // convex hull's, radius linear in s. A disc of radius r about unit
+        // axis w reaches r sqrt(1 - w_a^2) along axis a. The kernel keeps
+        // only r(s) >= 0, so a negative end radius is taken as 0 (the apex
+        // of that nappe lies between the ends).
+        const V h = V::load_unaligned(b.h), rb = V::load_unaligned(b.rb), zero(0.0f);
+        const V r_base = vmax(rb, zero), r_apex = vmax(vfmadd(V::load_unaligned(b.k), h, rb), zero);
+        for (int a = 0; a < 3; ++a) {
+            const V w = V::load_unaligned(b.w[a]), base = V::load_unaligned(b.base[a]);
+            const V apex = vfmadd(w, h, base);
+            const V reach = vsqrt(vmax(V(1.0f) - w * w, zero));
+            lo[a] = vmin(vfnmadd(r_base, reach, base), vfnmadd(r_apex, reach, apex));
+            hi[a] = vmax(vfmadd(r_base, reach, base), vfmadd(r_apex, reach, apex));
         }
         return true;
     } else {
