@@ -80,8 +80,10 @@ SurfaceTable::SurfaceTable(const Scene& scene) : scene_(scene), records_(scene.p
         } else if (ref.kind == PrimKind::Sphere) {
             r.v = scene.spheres.center[ref.index];
             kind = kSphere;
+        } else if (ref.kind == PrimKind::Cone) {
+            kind = kCone;  // SurfaceLanes reads the cone's ends and radii
         }
-        r.material_kind = scene.prim_material[p] << 2 | kind;
+        r.material_kind = scene.prim_material[p] << kKindBits | kind;
     }
 }
 

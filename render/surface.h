@@ -46,10 +46,11 @@ public:
 private:
     template <int K>
     friend struct SurfaceLanes;
-    enum Kind : std::uint32_t { kFlatTriangle, kSmoothTriangle, kSphere, kOther };
+    enum Kind : std::uint32_t { kFlatTriangle, kSmoothTriangle, kSphere, kCone, kOther };
+    static constexpr std::uint32_t kKindBits = 3, kKindMask = (1u << kKindBits) - 1;
     struct Record {
         Vec3f v;                     ///< triangle: unit geometric normal; sphere: centre
-        std::uint32_t material_kind;  ///< material << 2 | Kind
+        std::uint32_t material_kind;  ///< material << kKindBits | Kind
     };
     static_assert(sizeof(Record) == 16);
     const Scene& scene_;
@@ -65,8 +66,8 @@ inline Surface SurfaceTable::at(const Rayf& ray, const Hitf& hit, float time) co
     const std::uint32_t material_kind = r.material_kind;
     Surface s;
     s.point = ray.org + ray.dir * hit.t;
-    s.material = material_kind >> 2;
-    switch (Kind(material_kind & 3)) {
+    s.material = material_kind >> kKindBits;
+    switch (Kind(material_kind & kKindMask)) {
         case kFlatTriangle:
             s.geometric_normal = s.shading_normal = r.v;
             return s;
@@ -77,6 +78,7 @@ inline Surface SurfaceTable::at(const Rayf& ray, const Hitf& hit, float time) co
         case kSphere:
             s.geometric_normal = s.shading_normal = normalize(s.point - r.v);
             return s;
+        case kCone:
         case kOther: break;
     }
     return surface_at(scene_, ray, hit);

@@ -54,8 +54,8 @@ struct SurfaceLanes {
                      gather_floats<K>(record_words, record4 + I(2))};
             }
         }
-        material = xsimd::select(recorded, shift_right<K>(material_kind, 2), I(0));
-        const I kind = material_kind & I(3);
+        material = xsimd::select(recorded, shift_right<K>(material_kind, int(SurfaceTable::kKindBits)), I(0));
+        const I kind = material_kind & I(std::int32_t(SurfaceTable::kKindMask));
         const F t = gather_floats<K>(hit_words, hit4);
         const Vec3<F> org{gather_floats<K>(ray_words, ray8), gather_floats<K>(ray_words, ray8 + I(1)),
                           gather_floats<K>(ray_words, ray8 + I(2))};
@@ -68,6 +68,8 @@ struct SurfaceLanes {
         const std::uint32_t sphere = lanes & int_mask_bits<K>(recorded & (kind == I(SurfaceTable::kSphere)));
         const auto smooth_lanes = recorded & (kind == I(SurfaceTable::kSmoothTriangle));
         const std::uint32_t smooth = lanes & int_mask_bits<K>(smooth_lanes);
+        const auto cone_lanes = recorded & (kind == I(SurfaceTable::kCone));
+        const std::uint32_t cone = lanes & int_mask_bits<K>(cone_lanes);
         const std::uint32_t other = lanes & ~int_mask_bits<K>(recorded & (kind != I(SurfaceTable::kOther)));
         if (sphere != 0) {
             const Vec3<F> d = point - v;
@@ -100,8 +102,37 @@ struct SurfaceLanes {
             const Vec3<F> unit = n / len;
             for (int a = 0; a < 3; ++a) shading_normal[a] = select(m, unit[a], shading_normal[a]);
         }
+        if (cone != 0) {
+            // cone_normal, normalised, operation for operation (the same
+            // bits: contraction is off). Every lane reads a cone's ends.
+            const ConeSoA& c = table.scene_.cones;
+            const I any_cone = xsimd::select(cone_lanes, prim, I(first_lane<K>(prim, cone)));
+            const I cone_index = gather_ints<K>(reinterpret_cast<const std::int32_t*>(table.scene_.prims.data()),
+                                           shift_left<K>(any_cone, 1) + I(1));
+            const I index3 = cone_index * I(3);
+            const auto end = [&](const std::vector<Vec3f>& v) {
+                const auto* words = reinterpret_cast<const float*>(v.data());
+                return Vec3<F>{gather_floats<K>(words, index3), gather_floats<K>(words, index3 + I(1)),
+                               gather_floats<K>(words, index3 + I(2))};
+            };
+            const Vec3<F> base = end(c.base), axis = end(c.apex) - base;
+            const F rb = gather_floats<K>(c.base_radius.data(), cone_index),
+                    ra = gather_floats<K>(c.apex_radius.data(), cone_index);
+            const F h = vsqrt(dot(axis, axis));
+            const Vec3<F> w = axis / h;
+            const F k = (ra - rb) / h;
+            const F s = dot(point - base, w);
+            const Vec3<F> perp = (point - base) - w * s;
+            const Vec3<F> n = perp - w * ((rb + k * s) * k);
+            const Vec3<F> unit = n / vsqrt(dot(n, n));
+            const vmask<K> m = mask_from_bits<K>(cone);
+            for (int a = 0; a < 3; ++a) {
+                geometric_normal[a] = select(m, unit[a], geometric_normal[a]);
+                shading_normal[a] = select(m, unit[a], shading_normal[a]);
+            }
+        }
         if (other != 0) {
-            // Cones, height fields and instanced primitives: at(), lane by lane.
+            // Height fields and instanced primitives: at(), lane by lane.
             alignas(64) float lane_arrays[9][K];
             alignas(64) std::int32_t lane_index[K], lane_material[K];
             for (int a = 0; a < 3; ++a) {
