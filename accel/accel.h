@@ -97,6 +97,20 @@ public:
         occluded(rays, occluded_out);
     }
 
+    /// Whether intersect_stream and occluded_stream walk whole streams.
+    virtual bool supports_stream() const { return false; }
+    /// The same queries for rays whose neighbours go other ways (reflections
+    /// off curved surfaces, shadow rays from points all over the scene): the
+    /// whole batch walks the structure as one stream where it has streams
+    /// (supports_stream: bvh4 and bvh8 with AVX-512), else as packets of
+    /// `width`.
+    virtual void intersect_stream(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
+        intersect_packets(width, rays, hits);
+    }
+    virtual void occluded_stream(int width, std::span<const Rayf> rays, std::span<std::uint8_t> occluded_out) const {
+        occluded_packets(width, rays, occluded_out);
+    }
+
     /// The same queries for rays at times: times[i] is ray i's scene time
     /// (Scene::shutter_fraction), and moving placements (Scene::
     /// moving_instances) sit where they are at that time. The queries above

@@ -126,6 +126,25 @@ struct Scratch {
     RenderStats stats;
 };
 
+/// Whether most packets of 16 consecutive rays of `rays` spread over
+/// several direction octants: rays that packets and their groups cannot
+/// bound together (a group needs one octant), and that a stream walks
+/// faster. Measured on the renders' reflection rays: 4.6% of rings' packets
+/// and 12.4% of balls' lie in one octant, 63-79% of gears', mount's and
+/// teapot's (on which streams were 3-20% slower than packets).
+bool incoherent(std::span<const Rayf> rays) {
+    constexpr std::size_t kPacket = 16;
+    std::size_t packets = 0, one_octant = 0;
+    for (std::size_t first = 0; first + kPacket <= rays.size(); first += kPacket, ++packets) {
+        auto octant = [](const Rayf& r) { return (r.dir.x < 0.0f) | ((r.dir.y < 0.0f) << 1) | ((r.dir.z < 0.0f) << 2); };
+        const int o = octant(rays[first]);
+        bool same = true;
+        for (std::size_t i = first + 1; i < first + kPacket; ++i) same &= octant(rays[i]) == o;
+        one_octant += same;
+    }
+    return 2 * one_octant < packets;
+}
+
 class WhittedWavefront {
 public:
     WhittedWavefront(const Scene& scene, const Accel& accel, const WhittedOptions& options)
@@ -200,8 +219,8 @@ public:
         intersect(RayLog::Eye, 0, eye, tree);
         std::size_t begin = 0, end = eye;
         for (int depth = 1; begin < end; ++depth) {
-            if (depth > 1) intersect(RayLog::Bounce, begin, end, tree);
-            shade_level(begin, end, depth, s);
+            const bool streamed = depth > 1 && intersect(RayLog::Bounce, begin, end, tree);
+            shade_level(begin, end, depth, streamed, s);
             begin = end;
             end = tree.count;
         }
@@ -240,21 +259,31 @@ private:
     bool spawns_ = false;    ///< some material reflects or transmits (spawn_reflection)
 
     /// Closest hits of the tree's rays [begin, end) (eye rays or bounces),
-    /// at their times if timed.
-    void intersect(RayLog::Kind kind, std::size_t begin, std::size_t end, RayTree& tree) const {
+    /// at their times if timed. Bounces that go every which way (off curved
+    /// mirrors) walk the structure as one stream; true if they did.
+    bool intersect(RayLog::Kind kind, std::size_t begin, std::size_t end, RayTree& tree) const {
         const int width = kind == RayLog::Eye ? options_.packet : options_.secondary_packet;
         const auto rays = std::span(tree.rays).subspan(begin, end - begin);
         const auto hits = std::span(tree.hits).subspan(begin, end - begin);
         const auto times = std::span(tree.time).subspan(begin, timed_ ? end - begin : 0);
         if (options_.ray_log) options_.ray_log->add(kind, rays, times);
-        if (timed_) accel_.intersect_at(width, rays, times, hits);
-        else accel_.intersect_packets(width, rays, hits);
+        if (timed_) {
+            accel_.intersect_at(width, rays, times, hits);
+            return false;
+        }
+        if (kind == RayLog::Bounce && accel_.supports_stream() && incoherent(rays)) {
+            accel_.intersect_stream(width, rays, hits);
+            return true;
+        }
+        accel_.intersect_packets(width, rays, hits);
+        return false;
     }
 
     /// Shades the rays [begin, end) of the tree, which are of depth `depth`:
     /// first each hit's surface (in ray order), then each point light for
-    /// all points at once, then the other lights and the children.
-    void shade_level(std::size_t begin, std::size_t end, int depth, Scratch& s) const {
+    /// all points at once, then the other lights and the children. The
+    /// shadow rays from the hits of `streamed` rays go as a stream too.
+    void shade_level(std::size_t begin, std::size_t end, int depth, bool streamed, Scratch& s) const {
         RayTree& tree = s.tree;
         s.shadows.reset(light_buckets());
         s.points.clear();
@@ -307,7 +336,7 @@ private:
             for (std::size_t j = 0; j < s.points.size(); ++j) spawn_reflection(j, depth, s);
             for (const auto& [j, link] : s.refracting) spawn_refraction(j, link, s);
         }
-        trace_shadows(s);
+        trace_shadows(s, streamed);
     }
 
     /// n, or -n unless `keep`, component by component: a whole-vector
@@ -549,7 +578,7 @@ private:
 
     /// Traces the level's shadow rays as one batch, light by light, and adds
     /// the unoccluded contributions in light order, as the recursion did.
-    void trace_shadows(Scratch& s) const {
+    void trace_shadows(Scratch& s, bool stream) const {
         ShadowBatch& b = s.shadows;
         std::size_t total = 0, queues = 0;
         const ShadowQueue* only = nullptr;
@@ -573,6 +602,7 @@ private:
                 for (const std::int32_t owner : q.owner) b.times.push_back(s.tree.time[std::size_t(owner)]);
         if (options_.ray_log) options_.ray_log->add(RayLog::Shadow, all, b.times);
         if (timed_) accel_.occluded_at(options_.secondary_packet, all, b.times, b.occluded);
+        else if (stream) accel_.occluded_stream(options_.secondary_packet, all, b.occluded);
         else accel_.occluded_packets(options_.secondary_packet, all, b.occluded);
         std::size_t k = 0;
         for (const ShadowQueue& q : b.per_light)
@@ -615,7 +645,7 @@ RenderStats render_adaptive(const Scene& scene, const Accel& accel, const Whitte
     const int depth = std::clamp(options.adaptive_depth, 0, 8);
     const std::int64_t fine = std::int64_t(1) << depth;                        // fine units per pixel
     const std::uint64_t row = std::uint64_t(options.width) * std::uint64_t(fine) + 1;  // fine points per row
-    const TileGrid grid{options.width, options.height, options.tile_size};
+    const TileGrid grid{options.width, options.height, tile_side(options, accel, false)};
     PerWorker<Scratch> scratch;
     std::atomic<std::uint64_t> points{0};
     TileProgress progress(std::uint64_t(options.width) * std::uint64_t(options.height), options.progress,
@@ -703,13 +733,18 @@ RenderStats render_adaptive(const Scene& scene, const Accel& accel, const Whitte
 
 }  // namespace
 
+int tile_side(const WhittedOptions& options, const Accel& accel, bool one_sample_a_pixel) {
+    if (options.tile_size > 0) return options.tile_size;
+    return one_sample_a_pixel && accel.supports_stream() ? 64 : 16;
+}
+
 RenderStats render_whitted(const Scene& scene, const Accel& accel, const WhittedOptions& options, Image& image) {
     if (options.distribution && options.adaptive_threshold > 0) return render_adaptive(scene, accel, options, image);
     const auto start = std::chrono::steady_clock::now();
     const CameraFrame frame = make_camera_frame(scene.camera, options.width, options.height);
     const WhittedWavefront tracer(scene, accel, options);
     const int spp = options.distribution ? options.spp : 1;
-    const TileGrid grid{options.width, options.height, options.tile_size};
+    const TileGrid grid{options.width, options.height, tile_side(options, accel, spp == 1)};
     PerWorker<Scratch> scratch;
     TileProgress progress(std::uint64_t(options.width) * std::uint64_t(options.height), options.progress,
                           options.progress_context);

@@ -14,6 +14,7 @@
 // within relative 1e-5, the same occlusion, where a difference is only
 // accepted if the single-ray traversal gives the very same answer (those
 // cases, hits outside the primitive's own box, are test_wide_bvh.cpp's).
+// Streams of rays (accel/bvh/wide_stream_traversal.h) are held to the same.
 #include <gtest/gtest.h>
 #include "tests/test_paths.h"
 #include <tbb/blocked_range.h>
@@ -58,15 +59,17 @@ Scene load(const std::string& spec) {
 /// to 2 `grain` rays (so that every width gets a ragged last packet and
 /// group per batch when the count is not a multiple of it), traced with
 /// `width`.
+/// Stream: the same through intersect_stream / occluded_stream.
 std::vector<Hitf> trace(const Accel& accel, int width, bool any_hit, const std::vector<Rayf>& rays,
-                        std::size_t grain = 61) {
+                        std::size_t grain = 61, bool stream = false) {
     std::vector<Hitf> hits(rays.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), grain), [&](const auto& r) {
         const std::span<const Rayf> in(rays.data() + r.begin(), r.size());
         const std::span<Hitf> out(hits.data() + r.begin(), r.size());
-        if (!any_hit) return accel.intersect_packets(width, in, out);
+        if (!any_hit) return stream ? accel.intersect_stream(width, in, out) : accel.intersect_packets(width, in, out);
         std::vector<std::uint8_t> occ(r.size());
-        accel.occluded_packets(width, in, occ);
+        if (stream) accel.occluded_stream(width, in, occ);
+        else accel.occluded_packets(width, in, occ);
         for (std::size_t i = 0; i < r.size(); ++i) out[i].prim = occ[i] ? 0 : kNoPrim;
     });
     return hits;
@@ -265,6 +268,28 @@ void check_scene(const Scene& scene, const std::string& label) {
             }
             accel.set_packet_config(k, default_wide_packet_config(N, k));
         }
+        // Streams (wide_stream_traversal.h): the whole set as one, and
+        // batches of 300 to 600 rays (with the lists' ragged chunks); lists
+        // left alone below 1 ray (never), the default and 64 rays.
+        if (accel.supports_stream()) {
+            for (int below : {1, default_wide_packet_config(N, 16).stream_single_below, 64}) {
+                for (std::size_t grain : {set.rays.size(), std::size_t(300)}) {
+                    WidePacketConfig c = default_wide_packet_config(N, 16);
+                    c.stream_single_below = below;
+                    accel.set_packet_config(16, c);
+                    SCOPED_TRACE(label + " bvh" + std::to_string(N) + " " + set.name + " stream, alone below " +
+                                 std::to_string(below) + ", batches of " + std::to_string(grain));
+                    const std::vector<Hitf> stream = trace(accel, 16, set.any_hit, set.rays, grain, true);
+                    std::string first;
+                    EXPECT_EQ(count_unlike_single(set, single, stream, first), 0u)
+                        << "of " << set.rays.size() << " rays differ from the single-ray traversal" << first;
+                    first.clear();
+                    EXPECT_EQ(count_unlike_oracle(set, truth, single, stream, shared, first), 0u)
+                        << "of " << set.rays.size() << " rays differ from brute force" << first;
+                }
+            }
+            accel.set_packet_config(16, default_wide_packet_config(N, 16));
+        }
     }
     if (shared != 0)
         std::printf("[   NOTE   ] %s bvh%d: %zu packet answers differ from brute force exactly as the single "
@@ -309,6 +334,18 @@ TEST(WideBvhPacketApi, WidthsAndEmptyScene) {
     std::vector<std::uint8_t> occ(5, 1);
     accel.occluded_packets(8, rays, occ);
     for (std::uint8_t o : occ) EXPECT_EQ(o, 0);
+    // Streams: where AVX-512 is compiled in, for the packets' variant only;
+    // an empty tree and batches too small for a stream answer all the same.
+    EXPECT_EQ(accel.supports_stream(), kWideStreamCompiled);
+    EXPECT_FALSE(robust.supports_stream());
+    std::vector<Rayf> many(600, r);
+    std::vector<Hitf> many_hits(600);
+    many_hits[9].prim = 7;
+    accel.intersect_stream(16, many, many_hits);
+    for (const Hitf& h : many_hits) EXPECT_FALSE(h.found());
+    std::vector<std::uint8_t> many_occ(600, 1);
+    accel.occluded_stream(16, many, many_occ);
+    for (std::uint8_t o : many_occ) EXPECT_EQ(o, 0);
 }
 
 }  // namespace

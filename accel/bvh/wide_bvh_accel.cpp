@@ -133,6 +133,28 @@ void WideBvhAccel<N, M, Test>::occluded_packets(int width, std::span<const Rayf>
     });
 }
 
+/// Below this many rays a batch goes as packets: too few to fill the lists.
+constexpr std::size_t kMinStreamRays = 256;
+
+template <int N, int M, NodeTest Test>
+void WideBvhAccel<N, M, Test>::intersect_stream(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
+    if constexpr (kPackets && kWideStreamCompiled) {
+        if (rays.size() >= kMinStreamRays)
+            return wide_trace_stream<N, M, false>(bvh_, *scene_, kernels_, packet_config_[2], rays, hits, {});
+    }
+    intersect_packets(width, rays, hits);
+}
+
+template <int N, int M, NodeTest Test>
+void WideBvhAccel<N, M, Test>::occluded_stream(int width, std::span<const Rayf> rays,
+                                               std::span<std::uint8_t> occluded) const {
+    if constexpr (kPackets && kWideStreamCompiled) {
+        if (rays.size() >= kMinStreamRays)
+            return wide_trace_stream<N, M, true>(bvh_, *scene_, kernels_, packet_config_[2], rays, {}, occluded);
+    }
+    occluded_packets(width, rays, occluded);
+}
+
 #if defined(__SSE4_2__)
 template class WideBvhAccel<4, 4>;
 #endif

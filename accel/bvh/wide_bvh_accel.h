@@ -27,6 +27,10 @@ public:
     bool supports_packet(int width) const override;
     void intersect_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const override;
     void occluded_packets(int width, std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override;
+    /// Streams where kWideStreamCompiled, for the Ordered test and blocks of 8.
+    bool supports_stream() const override { return kPackets && kWideStreamCompiled; }
+    void intersect_stream(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const override;
+    void occluded_stream(int width, std::span<const Rayf> rays, std::span<std::uint8_t> occluded) const override;
     /// When packets of `width` fall back to single rays (for measurements and tests).
     void set_packet_config(int width, const WidePacketConfig& config);
     WidePacketConfig packet_config(int width) const;

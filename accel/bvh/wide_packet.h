@@ -34,6 +34,9 @@ struct WidePacketConfig {
     /// ray first (OccluderCache, accel/bvh/wide_traversal.h); never with
     /// --slabs plain.
     bool occluder_cache = true;
+    /// Streams (wide_trace_stream): a node's list of fewer rays than this
+    /// finishes its subtree one ray at a time.
+    int stream_single_below = 8;
 };
 
 /// The default switch point for N-wide trees and packets of K. Measured with
@@ -69,5 +72,23 @@ constexpr WidePacketConfig default_wide_packet_config(int n, int k) {
 template <int N, int M, int K, bool AnyHit>
 void wide_trace_packets(const WideBvh<N, M>& bvh, const Scene& scene, KernelChoice kernels,
                         const WidePacketConfig& config, std::span<const Rayf> rays, std::span<Hitf> hits);
+
+/// Whether this build walks streams: lists of rays are compacted 16 lanes
+/// at a time with AVX-512's compress.
+#if defined(__AVX512BW__)
+inline constexpr bool kWideStreamCompiled = true;
+#else
+inline constexpr bool kWideStreamCompiled = false;
+#endif
+
+/// Closest hits (AnyHit = false, into `hits`) or occlusion (AnyHit = true:
+/// occluded[i] = 1 where occluded) of `rays` walked as one stream
+/// (accel/bvh/wide_stream_traversal.h): for rays whose neighbours go other
+/// ways. Defined for N = 4, 8 with M = 8 where kWideStreamCompiled;
+/// --precision double traces packets of 16 instead.
+template <int N, int M, bool AnyHit>
+void wide_trace_stream(const WideBvh<N, M>& bvh, const Scene& scene, KernelChoice kernels,
+                       const WidePacketConfig& config, std::span<const Rayf> rays, std::span<Hitf> hits,
+                       std::span<std::uint8_t> occluded);
 
 }  // namespace raypack
