@@ -106,7 +106,7 @@ int run_render(const Args& args) {
                              {"--quiet", "-q", 0}, {"--integrator", "", 1}, {"--spp", "", 1}, {"--sampler", "", 1},
                              {"--seed", "", 1}, {"--light-samples", "", 1}, {"--filter", "", 1},
                              {"--rr-depth", "", 1}, {"--exposure", "", 1}, {"--adaptive", "", 1},
-                             {"--adaptive-depth", "", 1}, {"--counts", "", 0}, {"--save-rays", "", 1}});
+                             {"--adaptive-depth", "", 1}, {"--counts", "", 0}, {"--save-rays", "", 1}, {"--tile", "", 1}});
     for (OptionSpec& k : scene_option_specs()) spec.push_back(std::move(k));
     const ParsedArgs p(args, spec, 1);
     if (p.help() || p.positional().empty()) {
@@ -117,6 +117,8 @@ int run_render(const Args& args) {
             "  --res W H     resolution (default: the scene's, 512x512 for SPD)\n"
             "  --depth D     maximum ray depth, eye ray = 1 (default 5, the SPD protocol)\n"
             "  --threads T   worker threads (default: all cores)\n"
+            "  --tile S      pixels per tile side, a tile's rays of one depth being one batch (default 16;\n"
+            "                64 where streams carry the reflections: docs/renderer.md)\n"
             "  --aov cost    instead of shading: the traversal cost (nodes + primitive tests) of each\n"
             "                pixel's camera ray as a viridis heat map with its scale below the picture\n"
             "  --integrator whitted|distribution|path\n"
@@ -155,6 +157,7 @@ int run_render(const Args& args) {
     if (fastest) config.kind = fastest_config(RayWorkload::Camera).accel;
     WhittedOptions options;
     options.max_depth = int(p.integer("--depth", 5, 1, 64));
+    options.tile_size = int(p.integer("--tile", 0, 1, 4096));
     options.offset = offset_policy_from(p);
     const std::string integrator = p.has("--integrator") ? p.text("--integrator") : "whitted";
     if (integrator != "whitted" && integrator != "distribution" && integrator != "path")

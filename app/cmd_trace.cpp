@@ -27,8 +27,9 @@ namespace {
 // (trace_in_groups, accel/packet_driver.h).
 constexpr std::size_t kBatch = 4096;
 
-/// One pass over all rays, batches in parallel; returns milliseconds.
-double trace_all(const Accel& accel, int packet, const RayFile& file, std::vector<Hitf>& hits) {
+/// One pass over all rays, batches in parallel (each one stream with
+/// `stream`); returns milliseconds.
+double trace_all(const Accel& accel, int packet, bool stream, const RayFile& file, std::vector<Hitf>& hits) {
     const auto start = std::chrono::steady_clock::now();
     const std::size_t n = file.rays.size();
     ThreadsSpread spread;  // one CPU per thread
@@ -42,13 +43,15 @@ double trace_all(const Accel& accel, int packet, const RayFile& file, std::vecto
                 file.times.empty() ? std::span<const float>{} : std::span<const float>(file.times.data() + lo, hi - lo);
             if (file.kind == RayKind::ClosestHit) {
                 const std::span<Hitf> out(hits.data() + lo, hi - lo);
-                if (times.empty()) accel.intersect_packets(packet, rays, out);
-                else accel.intersect_at(packet, rays, times, out);
+                if (!times.empty()) accel.intersect_at(packet, rays, times, out);
+                else if (stream) accel.intersect_stream(packet, rays, out);
+                else accel.intersect_packets(packet, rays, out);
             } else {
                 std::uint8_t occluded[kBatch];
                 const std::span<std::uint8_t> out(occluded, hi - lo);
-                if (times.empty()) accel.occluded_packets(packet, rays, out);
-                else accel.occluded_at(packet, rays, times, out);
+                if (!times.empty()) accel.occluded_at(packet, rays, times, out);
+                else if (stream) accel.occluded_stream(packet, rays, out);
+                else accel.occluded_packets(packet, rays, out);
                 for (std::size_t i = lo; i < hi; ++i) {
                     hits[i] = Hitf{};
                     if (occluded[i - lo]) hits[i].prim = 0;  // rays.md: 0 = occluded
@@ -65,15 +68,17 @@ int run_trace(const Args& args) {
     auto spec = accel_option_specs();
     for (OptionSpec& k : scene_option_specs()) spec.push_back(std::move(k));
     spec.insert(spec.end(), {{"--rays", "", 1}, {"--output", "-o", 1}, {"--threads", "", 1}, {"--repeat", "", 1},
-                             {"--json", "", 0}});
+                             {"--json", "", 0}, {"--stream", "", 0}});
     const ParsedArgs p(args, spec, 1);
     if (p.help() || p.positional().empty()) {
         std::printf(
-            "usage: raypack trace SCENE --rays FILE.rays [-o FILE.hits] [--threads T] [--repeat R] [--json]\n"
+            "usage: raypack trace SCENE --rays FILE.rays [-o FILE.hits] [--threads T] [--repeat R] [--stream] [--json]\n"
             "  --rays FILE   rays to trace (docs/rays.md); kind 1 files answer occlusion\n"
             "  -o FILE       write the hits (docs/rays.md)\n"
             "  --repeat R    timed passes after one untimed warm-up (default 5); the median is reported\n"
             "  --threads T   worker threads (default: all cores)\n"
+            "  --stream      each batch of 4096 rays walks the structure as one stream (bvh4, bvh8 with\n"
+            "                AVX-512; docs/structures.md): for incoherent rays; batches under 256 go as packets\n"
             "  --json        print one JSON line instead of text\n%s",
             (accel_options_help() + scene_option_help()).c_str());
         if (!p.help()) throw UsageError("missing SCENE");
@@ -91,10 +96,15 @@ int run_trace(const Args& args) {
     if (fastest) config.kind = fastest_config(workload).accel;
     const auto accel = build_accel(scene, config);
     const int packet = fastest ? supported_packet(*accel, fastest_config(workload).packet) : packet_width_from(p, *accel);
+    const bool stream = p.has("--stream");
+    if (stream && !accel->supports_stream())
+        throw UsageError("--stream: " + accel->stats().name +
+                         " has no stream traversal in this build (bvh4 and bvh8 with AVX-512 have)");
+    if (stream && !file.times.empty()) throw UsageError("--stream: rays at times (a version 2 file) go as packets");
     std::vector<Hitf> hits(file.rays.size());
-    trace_all(*accel, packet, file, hits);  // warm-up, untimed
+    trace_all(*accel, packet, stream, file, hits);  // warm-up, untimed
     std::vector<double> times;
-    for (int r = 0; r < repeat; ++r) times.push_back(trace_all(*accel, packet, file, hits));
+    for (int r = 0; r < repeat; ++r) times.push_back(trace_all(*accel, packet, stream, file, hits));
     std::vector<double> sorted = times;
     std::sort(sorted.begin(), sorted.end());
     const double median = sorted.size() % 2 ? sorted[sorted.size() / 2]
@@ -112,6 +122,7 @@ int run_trace(const Args& args) {
         j["accel"] = as.name;
         j["builder"] = as.builder;
         j["packet"] = packet;
+        j["stream"] = stream;
         // Packets per shared walk, at most (1: alone). The k-d tree groups
         // rays from one point (robust slabs), the octree rays of one octant,
         // both in float precision; both keep the rest alone.
@@ -157,8 +168,8 @@ int run_trace(const Args& args) {
         if (!is_embree_kind(as.name))
             std::printf("  kernels: %s; loops for %s primitives\n", kernel_choice_summary(config.kernels).c_str(),
                         specialisation_name(as.specialisation));
-        std::printf("  packets of %d, %d threads, %d passes: median %.2f ms (min %.2f, max %.2f), %.2f Mrays/s; %zu %s\n",
-                    packet, limit.threads(), repeat, median, sorted.front(), sorted.back(), mrays, hit_count,
+        std::printf("  %s of %d, %d threads, %d passes: median %.2f ms (min %.2f, max %.2f), %.2f Mrays/s; %zu %s\n",
+                    stream ? "streams of batches, else packets" : "packets", packet, limit.threads(), repeat, median, sorted.front(), sorted.back(), mrays, hit_count,
                     file.kind == RayKind::ClosestHit ? "hits" : "occluded");
         if (fastest)
             std::printf("  (%s rays: the fastest measured configuration; --accel/--packet/--builder choose another)\n",

@@ -17,7 +17,7 @@ void print_usage(std::FILE* out) {
         "\n"
         "commands:\n"
         "  render SCENE [-o out.png] [--res W H] [--depth D] [--threads T]\n"
-        "  trace  SCENE --rays FILE.rays [-o FILE.hits] [--threads T] [--repeat R] [--json]\n"
+        "  trace  SCENE --rays FILE.rays [-o FILE.hits] [--threads T] [--repeat R] [--stream] [--json]\n"
         "  info   SCENE\n"
         "  gen    NAME --size S -o FILE.nff\n"
         "  rays   SCENE --kind camera|shadow|diffuse [--res W H] -o FILE.rays\n"

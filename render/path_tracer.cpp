@@ -745,7 +745,7 @@ RenderStats render_path(const Scene& scene, const Accel& accel, const WhittedOpt
     const CameraFrame frame = make_camera_frame(scene.camera, options.width, options.height);
     const PathTracer tracer(scene, accel, options, path);
     const int spp = options.spp;
-    const TileGrid grid{options.width, options.height, tile_side(options, accel, false)};
+    const TileGrid grid = render_tiles(scene, options, accel, false);
     PerWorker<Scratch> scratch;
     TileProgress progress(std::uint64_t(options.width) * std::uint64_t(options.height), options.progress,
                           options.progress_context);

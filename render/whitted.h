@@ -15,6 +15,7 @@
 #include "render/ray_log.h"
 #include "render/ray_offset.h"
 #include "render/sampler.h"
+#include "render/tiles.h"
 #include "scene/scene.h"
 
 namespace raypack {
@@ -32,8 +33,8 @@ struct WhittedOptions {
     int packet = 1;
     /// Reflection, refraction and shadow rays: packets of this width.
     int secondary_packet = 1;
-    /// Pixels per tile side: a tile's rays of one depth form one batch.
-    /// 0: tile_side's choice.
+    /// Pixels per tile side; 0: render_tiles' choice. A tile's rays of one
+    /// depth form one batch.
     int tile_size = 0;
     /// Distribution ray tracing: the effects below are sampled. Off (the
     /// Whitted integrator), one ray per pixel centre, the lens is a pinhole,
@@ -86,13 +87,17 @@ struct RenderStats {
     RenderStats& operator+=(const RenderStats& o);
 };
 
-/// The tile side a render uses: options.tile_size, or by default 64 pixels
-/// for one sample a pixel on a structure that walks streams (a batch of
-/// 4,096 eye rays, whose reflections off curved mirrors fill a stream: 1.24x
-/// faster renders of rings and balls than tiles of 16 in packets; tiles of
-/// 64 without streams were 2-4% slower on gears, mount and teapot) and 16
-/// otherwise (16 x 16 pixels x their samples).
-int tile_side(const WhittedOptions& options, const Accel& accel, bool one_sample_a_pixel);
+/// The tiles a render walks (render/tiles.h): sides of options.tile_size,
+/// or by default 64 pixels where streams will carry the reflections (one
+/// sample a pixel, a structure with streams, and spheres and cones that
+/// reflect or transmit making up half the scene or more: rings and balls,
+/// rendered 1.2-1.3x faster at one thread than in tiles of 16), else 16.
+/// Tiles of 64 everywhere were 2-4% slower at one thread on gears, mount
+/// and teapot, and lost much of two threads' speed-up on the short renders
+/// (tetra 1.63x -> 1.28x, mount 1.76x -> 1.12x); rings' and balls' two-thread
+/// speed-ups drop too (1.83x -> 1.69x, 1.92x -> 1.58x), their times improve.
+TileGrid render_tiles(const Scene& scene, const WhittedOptions& options, const Accel& accel,
+                      bool one_sample_a_pixel);
 
 /// Renders one sample per pixel centre, tiles in parallel with oneTBB (the
 /// caller limits threads with tbb::global_control). With one sample a
