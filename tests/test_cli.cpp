@@ -222,6 +222,39 @@ TEST(Cli, TraceAnswersClosestAndAnyHitWithJson) {
     }
 }
 
+/// trace --stream (bvh4 and bvh8 with AVX-512): the same answers as packets
+/// (hits at the same t; the primitive may differ only between coincident
+/// hits); a structure without streams is a usage error.
+TEST(Cli, TraceStreamAnswersAsPacketsDo) {
+    const fs::path dir = temp_dir();
+    const std::string scene = "gen:balls:2";
+    const std::string base = "trace " + scene + " --repeat 1 --threads 2 --accel bvh4 --packet 16";
+    for (const char* kind : {"diffuse", "shadow"}) {
+        const std::string rays = (dir / (std::string(kind) + ".rays")).string();
+        ASSERT_EQ(run("rays " + scene + " --kind " + kind + " --res 80 80 -o " + rays).status, 0);
+        const std::string packets = (dir / (std::string(kind) + "-packets.hits")).string();
+        const std::string stream = (dir / (std::string(kind) + "-stream.hits")).string();
+        ASSERT_EQ(run(base + " --rays " + rays + " -o " + packets).status, 0);
+        const Result r = run(base + " --rays " + rays + " -o " + stream + " --stream --json");
+        if (r.status == 2 && r.output.find("no stream traversal") != std::string::npos)
+            GTEST_SKIP() << "this build has no streams (AVX-512)";
+        ASSERT_EQ(r.status, 0) << r.output;
+        EXPECT_TRUE(nlohmann::json::parse(r.output)["stream"].get<bool>());
+        const auto a = read_hits(packets), b = read_hits(stream);
+        ASSERT_EQ(a.size(), b.size());
+        std::size_t differ = 0, found = 0;
+        for (std::size_t i = 0; i < a.size(); ++i) {
+            found += a[i].found();
+            differ += a[i].found() != b[i].found() || (a[i].found() && std::string(kind) == "diffuse" && a[i].t != b[i].t);
+        }
+        EXPECT_EQ(differ, 0u) << kind;
+        EXPECT_GT(found, 0u) << kind;
+    }
+    const Result grid = run("trace " + scene + " --rays " + (dir / "diffuse.rays").string() + " --accel grid --stream");
+    EXPECT_EQ(grid.status, 2) << grid.output;
+    EXPECT_NE(grid.output.find("--stream: grid has no stream traversal"), std::string::npos) << grid.output;
+}
+
 /// A scene that moves: rays carry times (a version 2 file), every one in
 /// the shutter, and trace answers at those times as brute force does; the
 /// same rays without their times (at the opening) answer differently.
@@ -332,6 +365,7 @@ TEST(Cli, BadFlagsAreUsageErrors) {
         {"render " + scene_path("tetra.nff") + " --res 0 10", "--res must be between 1 and 65536"},
         {"render " + scene_path("tetra.nff") + " --res 64", "--res needs 2 value(s)"},
         {"render " + scene_path("tetra.nff") + " --depth x", "--depth expects an integer"},
+        {"render " + scene_path("tetra.nff") + " --tile 0", "--tile must be between 1 and 4096"},
         {"render " + scene_path("tetra.nff") + " --accel octopus", "unknown structure 'octopus'"},
         {"trace " + scene_path("tetra.nff"), "missing --rays"},
         {"render " + scene_path("tetra.nff") + " --packet 3", "--packet: expected 1, 4, 8 or 16"},
