@@ -69,8 +69,8 @@ std::string kernel_choice_summary(const KernelChoice& k) {
 
 std::string accel_options_help() {
     return "  With none of --accel, --builder, --packet: the fastest measured configuration for the rays\n"
-           "  (camera: bvh4 --packet 16, shadow: bvh8 --packet 16, diffuse: bvh4 --packet 16; without AVX-512\n"
-           "  packets of 8 and diffuse bvh8 --packet 1; docs/embree.md)\n"
+           "  (camera: bvh4 --packet 16, shadow: bvh8 --packet 16, diffuse: bvh4 --packet 16, in trace as\n"
+           "  streams; without AVX-512 packets of 8 and diffuse bvh8 --packet 1; docs/embree.md)\n"
            "  --accel " + accel_kinds_list() + "  acceleration structure (default bvh2)\n"
            "  --builder " + bvh_builder_list() + "  BVH builder for bvh2|bvh4|bvh8 (default binned):\n"
            "                binned SAH, full-sweep SAH, Morton/LBVH, spatial splits (SBVH)\n"

@@ -96,7 +96,7 @@ int run_trace(const Args& args) {
     if (fastest) config.kind = fastest_config(workload).accel;
     const auto accel = build_accel(scene, config);
     const int packet = fastest ? supported_packet(*accel, fastest_config(workload).packet) : packet_width_from(p, *accel);
-    const bool stream = p.has("--stream");
+    const bool stream = p.has("--stream") || (fastest && fastest_config(workload).stream && accel->supports_stream());
     if (stream && !accel->supports_stream())
         throw UsageError("--stream: " + accel->stats().name +
                          " has no stream traversal in this build (bvh4 and bvh8 with AVX-512 have)");

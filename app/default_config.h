@@ -21,6 +21,8 @@ RayWorkload classify_workload(std::span<const Rayf> rays, bool any_hit);
 struct TraceConfig {
     std::string accel;
     int packet;
+    /// Batches walk the structure as streams (Accel::intersect_stream).
+    bool stream = false;
 };
 
 /// The fastest measured configuration for `workload`, with the packet width

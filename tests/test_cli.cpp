@@ -321,6 +321,8 @@ TEST(Cli, TraceDefaultsToTheFastestConfigurationForTheRays) {
         EXPECT_EQ(j["workload"], c.workload);
         EXPECT_EQ(j["accel"], c.accel) << c.kind;
         EXPECT_EQ(j["packet"].get<int>(), c.packet) << c.kind;
+        // With AVX-512, diffuse rays go as streams.
+        EXPECT_EQ(j["stream"].get<bool>(), wide && std::string(c.kind) == "diffuse") << c.kind;
         // Packets walk in groups of 128 rays (accel/bvh/wide_packet.h); single rays alone.
         EXPECT_EQ(j["group"].get<int>(), c.packet > 1 ? 128 / c.packet : 1) << c.kind;
         const Result named = run("trace " + scene + " --rays " + rays + " --repeat 1 --json --accel bvh2");
