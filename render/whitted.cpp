@@ -725,7 +725,10 @@ TileGrid render_tiles(const Scene& scene, const WhittedOptions& options, const A
         curved_mirrors += (kind == PrimKind::Sphere || kind == PrimKind::Cone) && (m.ks > 0 || m.transmittance > 0);
     }
     const bool streams = one_sample_a_pixel && accel.supports_stream() && 2 * curved_mirrors >= scene.prims.size();
-    return {options.width, options.height, streams ? 64 : 16};
+    if (!streams) return {options.width, options.height, 16};
+    // One thread: 64. Several: 32, so that tiles of uneven cost still
+    // spread evenly over the threads.
+    return {options.width, options.height, worker_slots() > 1 ? 32 : 64};
 }
 
 RenderStats render_whitted(const Scene& scene, const Accel& accel, const WhittedOptions& options, Image& image) {

@@ -88,14 +88,15 @@ struct RenderStats {
 };
 
 /// The tiles a render walks (render/tiles.h): sides of options.tile_size,
-/// or by default 64 pixels where streams will carry the reflections (one
+/// or by default 16, except where streams will carry the reflections (one
 /// sample a pixel, a structure with streams, and spheres and cones that
-/// reflect or transmit making up half the scene or more: rings and balls,
-/// rendered 1.2-1.3x faster at one thread than in tiles of 16), else 16.
-/// Tiles of 64 everywhere were 2-4% slower at one thread on gears, mount
-/// and teapot, and lost much of two threads' speed-up on the short renders
-/// (tetra 1.63x -> 1.28x, mount 1.76x -> 1.12x); rings' and balls' two-thread
-/// speed-ups drop too (1.83x -> 1.69x, 1.92x -> 1.58x), their times improve.
+/// reflect or transmit making up half the scene or more: rings, balls),
+/// whose batches want to be large: 64 at one thread (rings and balls 1.28x
+/// and 1.24x faster than in tiles of 16), 32 with more threads (at 64, the
+/// two-thread renders spread unevenly: balls 2T/1T 1.6x against 2.1x at
+/// 32). Tiles of 64 everywhere were 2-4% slower at one thread on gears,
+/// mount and teapot, and the short renders lost much of two threads'
+/// speed-up (tetra 1.63x -> 1.28x, mount 1.76x -> 1.12x).
 TileGrid render_tiles(const Scene& scene, const WhittedOptions& options, const Accel& accel,
                       bool one_sample_a_pixel);
 
