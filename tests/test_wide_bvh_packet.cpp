@@ -313,6 +313,23 @@ std::string spec_name(const ::testing::TestParamInfo<std::string>& info) {
 
 INSTANTIATE_TEST_SUITE_P(, WideBvhPacket, ::testing::ValuesIn(scene_specs()), spec_name);
 
+// A batch of more than 65,536 rays walks as several streams (ray numbers
+// are 32-bit fields of the lists): the same answers as single rays.
+TEST(WideBvhPacketApi, StreamsLongerThanOneWalk) {
+    const Scene scene = load("gen:balls:1");
+    WideBvhAccel<4, 8> accel(scene, AccelConfig{});
+    if (!accel.supports_stream()) GTEST_SKIP() << "no streams in this build (AVX-512)";
+    std::mt19937 rng(7);
+    const Box3f box = grown(scene_bounds(scene), 0.1f);
+    for (bool any_hit : {false, true}) {
+        const RaySet set{"random", random_rays_in(rng, box, length(box.extent()), 70001), any_hit};
+        const std::vector<Hitf> single = trace(accel, 1, any_hit, set.rays, set.rays.size());
+        const std::vector<Hitf> stream = trace(accel, 16, any_hit, set.rays, set.rays.size(), true);
+        std::string first;
+        EXPECT_EQ(count_unlike_single(set, single, stream, first), 0u) << first;
+    }
+}
+
 TEST(WideBvhPacketApi, WidthsAndEmptyScene) {
     Scene empty;
     empty.update_features();

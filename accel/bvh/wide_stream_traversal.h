@@ -7,9 +7,11 @@
 // against its whole list K rays at a time (K rays x 1 box, the packet
 // traversal's child_hits), and each child gets the list of the rays that
 // meet it, compacted with AVX-512's compress. The lists carry their rays'
-// data (origin, direction, reciprocals, tnear and the tfar the list was made
-// with), so that no node gathers. Children are visited nearest first by
-// the mean entry distance of their rays; a leaf tests each primitive against
+// data (origin, direction, reciprocals, tnear and the entry distance into
+// the list's node), so that a node gathers only the rays' current closest
+// hits, which drop the rays that have found one nearer than the node.
+// Children are visited nearest first by the mean entry distance of their
+// rays; a leaf tests each primitive against
 // its list K rays at a time with the packet traversal's kernels (packet_leaf),
 // reading each ray's current closest hit and writing back the ones it
 // improves; a list shorter than `single_below` finishes its subtree one ray
@@ -348,7 +350,7 @@ void trace_stream(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, int sing
         LoadedPacket<K> p;
         alignas(64) std::uint32_t ids[K];
         for (int l = 0; l < K; ++l) ids[l] = std::uint32_t(l);
-        F id = F::load_aligned(reinterpret_cast<const float*>(ids));
+        F id = F(_mm512_castsi512_ps(_mm512_load_si512(ids)));  // ray numbers as float bits
         const F step(std::bit_cast<float>(std::uint32_t(K)));
         for (std::size_t first = 0; first < n; first += K) {
             load_fresh_packet<K>(rays, first, pk.kernels.rcp, p);
@@ -400,9 +402,17 @@ void wide_trace_stream(const WideBvh<N, M>& bvh, const Scene& scene, KernelChoic
         return;
     }
     const wide_packet_detail::PacketKernels<K> pk{kernels, {&scene, kernels}, {&scene, kernels}};
+    // Streams of at most 65,536 rays: ray numbers fit the lists' 32-bit
+    // fields and the lists' memory stays bounded (their gain has levelled
+    // off by 4,096 rays).
+    constexpr std::size_t kMaxStream = std::size_t(1) << 16;
     auto run = [&]<TriangleMethod TM, class Kinds = PrimKinds>() {
-        wide_stream_detail::trace_stream<N, M, K, TM, AnyHit, Kinds>(bvh, pk, config.stream_single_below, rays, hits,
-                                                                     occluded);
+        for (std::size_t first = 0; first < rays.size(); first += kMaxStream) {
+            const std::size_t n = std::min(kMaxStream, rays.size() - first);
+            wide_stream_detail::trace_stream<N, M, K, TM, AnyHit, Kinds>(
+                bvh, pk, config.stream_single_below, rays.subspan(first, n),
+                AnyHit ? hits : hits.subspan(first, n), AnyHit ? occluded.subspan(first, n) : occluded);
+        }
     };
     if (specialisation_for(scene, kernels) == KindSpecialisation::Triangles)
         return run.template operator()<TriangleMethod::Moeller, TriangleKinds>();
