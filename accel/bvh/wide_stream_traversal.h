@@ -82,7 +82,7 @@ inline StreamArena& thread_arena() {
 }
 
 #if defined(__AVX512F__)
-/// The current per-ray state of a query (by ray id).
+/// The current per-ray state of a query (by ray id); any hit: t, u, v null.
 struct StreamRays {
     float* tfar;
     float* t;
@@ -176,7 +176,8 @@ private:
             r.dir = {field[kDx][j], field[kDy][j], field[kDz][j]};
             r.tnear = field[kTnear][j];
             r.tfar = tfar;
-            Hitf h{rays_.t[id], rays_.prim[id], rays_.u[id], rays_.v[id]};
+            Hitf h;  // any hit keeps no hit records (rays_.t, u, v are null)
+            if constexpr (!AnyHit) h = Hitf{rays_.t[id], rays_.prim[id], rays_.u[id], rays_.v[id]};
             const NodeRay<N> nr = make_node_ray<NodeTest::Ordered, N>(r, pk_.kernels.slabs, pk_.kernels.rcp);
             const LeafRay<vfloat<M>> lr = make_leaf_ray<vfloat<M>>(r, TM);
             float t = tfar;
@@ -370,8 +371,10 @@ void trace_stream(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, int sing
             arena.u[i] = arena.v[i] = 0.0f;
         }
     }
-    StreamWalk<N, M, K, TM, AnyHit, Kinds> walk(
-        bvh, pk, single_below, {tfar.data(), arena.t.data(), arena.u.data(), arena.v.data(), arena.prim.data()}, arena);
+    const StreamRays state = AnyHit ? StreamRays{tfar.data(), nullptr, nullptr, nullptr, arena.prim.data()}
+                                    : StreamRays{tfar.data(), arena.t.data(), arena.u.data(), arena.v.data(),
+                                                 arena.prim.data()};
+    StreamWalk<N, M, K, TM, AnyHit, Kinds> walk(bvh, pk, single_below, state, arena);
     walk.run({0, std::uint32_t(n), cap, at});
     for (std::size_t i = 0; i < n; ++i) {
         if constexpr (AnyHit) occluded[i] = arena.prim[i] == 0 ? 1 : 0;
