@@ -18,9 +18,9 @@ namespace raypack {
 /// gears 3-5% slower, balls and rings within noise.
 inline bool incoherent(std::span<const Rayf> rays) {
     constexpr std::size_t kPacket = 16;
+    auto octant = [](const Rayf& r) { return (r.dir.x < 0.0f) | ((r.dir.y < 0.0f) << 1) | ((r.dir.z < 0.0f) << 2); };
     std::size_t packets = 0, one_octant = 0;
     for (std::size_t first = 0; first + kPacket <= rays.size(); first += kPacket, ++packets) {
-        auto octant = [](const Rayf& r) { return (r.dir.x < 0.0f) | ((r.dir.y < 0.0f) << 1) | ((r.dir.z < 0.0f) << 2); };
         const int o = octant(rays[first]);
         bool same = true;
         for (std::size_t i = first + 1; i < first + kPacket; ++i) same &= octant(rays[i]) == o;

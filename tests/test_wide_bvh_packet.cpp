@@ -343,26 +343,23 @@ TEST(WideBvhPacketApi, WidthsAndEmptyScene) {
     EXPECT_FALSE(robust.supports_packet(8));
     Rayf r;
     r.dir = {0, 0, 1};
-    std::vector<Rayf> rays(5, r);
-    std::vector<Hitf> hits(5);
-    hits[2].prim = 7;
-    accel.intersect_packets(8, rays, hits);
-    for (const Hitf& h : hits) EXPECT_FALSE(h.found());
-    std::vector<std::uint8_t> occ(5, 1);
-    accel.occluded_packets(8, rays, occ);
-    for (std::uint8_t o : occ) EXPECT_EQ(o, 0);
-    // Streams: where AVX-512 is compiled in, for the packets' variant only;
-    // an empty tree and batches too small for a stream answer all the same.
+    // Every answer written, none found: packets of 8 on 5 rays, and streams
+    // (a batch of 600; where AVX-512 is compiled in, for the packets'
+    // variant only) on the empty tree.
     EXPECT_EQ(accel.supports_stream(), kWideStreamCompiled);
     EXPECT_FALSE(robust.supports_stream());
-    std::vector<Rayf> many(600, r);
-    std::vector<Hitf> many_hits(600);
-    many_hits[9].prim = 7;
-    accel.intersect_stream(16, many, many_hits);
-    for (const Hitf& h : many_hits) EXPECT_FALSE(h.found());
-    std::vector<std::uint8_t> many_occ(600, 1);
-    accel.occluded_stream(16, many, many_occ);
-    for (std::uint8_t o : many_occ) EXPECT_EQ(o, 0);
+    for (const bool stream : {false, true}) {
+        const std::vector<Rayf> batch(stream ? 600 : 5, r);
+        std::vector<Hitf> hits(batch.size());
+        hits[2].prim = 7;
+        if (stream) accel.intersect_stream(16, batch, hits);
+        else accel.intersect_packets(8, batch, hits);
+        for (const Hitf& h : hits) EXPECT_FALSE(h.found());
+        std::vector<std::uint8_t> occ(batch.size(), 1);
+        if (stream) accel.occluded_stream(16, batch, occ);
+        else accel.occluded_packets(8, batch, occ);
+        for (std::uint8_t o : occ) EXPECT_EQ(o, 0);
+    }
 }
 
 }  // namespace

@@ -58,6 +58,17 @@ RAYPACK_INLINE F next_away_from_zero(const F& x) {
     }
 }
 
+/// The far-plane reciprocals of the Ordered node test from the near ones
+/// `r`: widened by kFarWiden and one ulp away from zero (robust slabs,
+/// Ize 2013), or `r` itself (plain slabs).
+template <int K>
+RAYPACK_INLINE vfloat<K> far_reciprocal(const vfloat<K>& r, bool widen) {
+    using F = vfloat<K>;
+    if (!widen) return r;
+    F w = r * F(kFarWiden);
+    return select(vabs(w) == F(std::numeric_limits<float>::infinity()), w, next_away_from_zero(w));
+}
+
 /// The packet as the node and leaf tests see it, computed once per packet.
 template <int K>
 struct PacketNodeRay {
@@ -81,12 +92,7 @@ RAYPACK_INLINE void set_packet_node_ray(const RayPacket<K>& p, SlabMethod slabs,
     const bool widen = slabs == SlabMethod::Robust;
     auto axis = [&](const F& d, const F& rd, F& r, F& r_far, vmask<K>& negative) {
         r = select(vabs(d) < F(kMinRcpInput), copysign_of(inf, d), rd);
-        if (widen) {
-            F w = r * F(kFarWiden);
-            r_far = select(vabs(w) == inf, w, next_away_from_zero(w));
-        } else {
-            r_far = r;
-        }
+        r_far = far_reciprocal<K>(r, widen);
         negative = r < F(0.0f);
     };
     axis(p.dir.x, p.rdir.x, n.rdir.x, n.rdir_far.x, n.neg_x);

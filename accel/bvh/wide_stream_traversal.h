@@ -101,17 +101,11 @@ RAYPACK_INLINE vint<K> load_ids(const float* f) {
 template <int K>
 RAYPACK_INLINE void load_node_ray(const float* const* field, std::uint32_t i, SlabMethod slabs, PacketNodeRay<K>& n) {
     using F = vfloat<K>;
-    const F inf(std::numeric_limits<float>::infinity());
     const bool widen = slabs == SlabMethod::Robust;
     auto axis = [&](int o, int r, F& org, F& rd, F& rd_far, vmask<K>& negative) {
         org = F::load_aligned(field[o] + i);
         rd = F::load_aligned(field[r] + i);
-        if (widen) {
-            F w = rd * F(kFarWiden);
-            rd_far = select(vabs(w) == inf, w, wide_packet_detail::next_away_from_zero(w));
-        } else {
-            rd_far = rd;
-        }
+        rd_far = wide_packet_detail::far_reciprocal<K>(rd, widen);
         negative = rd < F(0.0f);
     };
     axis(kOx, kRx, n.org.x, n.rdir.x, n.rdir_far.x, n.neg_x);
