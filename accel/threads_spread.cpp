@@ -2,6 +2,7 @@
 
 #include <sys/stat.h>
 #include <unistd.h>
+#include <tbb/global_control.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -46,9 +47,17 @@ bool own_thread(int tid) {
 
 }  // namespace
 
+int ThreadsSpread::threads() {
+    const std::size_t limit = tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
+    return int(std::min<std::size_t>(std::size_t(tbb::this_task_arena::max_concurrency()), limit));
+}
+
 void ThreadsSpread::start_workers() {
     workers();
-    const int slots = tbb::this_task_arena::max_concurrency();
+    // Under a limit of one thread, an enqueued task still wakes a worker
+    // (TBB's mandatory concurrency), which then took part in a quarter of
+    // the `--threads 1` renders.
+    const int slots = threads();
     for (int k = 1; k < slots; ++k)
         tbb::this_task_arena::enqueue([] {
             if (tbb::this_task_arena::current_thread_index() > 0) workers().add(int(gettid()));

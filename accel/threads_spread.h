@@ -36,6 +36,11 @@ public:
     /// scene loads). Nothing at one thread.
     static void start_workers();
 
+    /// Threads a parallel loop may run on now: the arena's concurrency
+    /// within the limit of a tbb::global_control (`--threads`), which
+    /// this_task_arena::max_concurrency() does not reflect.
+    static int threads();
+
 private:
     std::thread::id caller_ = std::this_thread::get_id();
     bool caller_pinned_ = false;

@@ -31,6 +31,10 @@ void for_each_tile(const TileGrid& grid, const std::function<void(int tile, int 
 /// Upper bound of the slots for_each_tile passes (the TBB arena's workers).
 int worker_slots();
 
+/// Threads for_each_tile runs on now: worker_slots() within the limit of
+/// `--threads` (a tbb::global_control).
+int worker_threads();
+
 /// One scratch object per worker slot of for_each_tile, made on first use,
 /// so that each worker reuses its memory and keeps its own counters.
 template <class T>

@@ -728,7 +728,7 @@ TileGrid render_tiles(const Scene& scene, const WhittedOptions& options, const A
     if (!streams) return {options.width, options.height, 16};
     // One thread: 64. Several: 32, so that tiles of uneven cost still
     // spread evenly over the threads.
-    return {options.width, options.height, worker_slots() > 1 ? 32 : 64};
+    return {options.width, options.height, worker_threads() > 1 ? 32 : 64};
 }
 
 RenderStats render_whitted(const Scene& scene, const Accel& accel, const WhittedOptions& options, Image& image) {

@@ -77,6 +77,28 @@ TEST(Tiles, ThreadsRunOnCpusOfTheirOwn) {
     EXPECT_TRUE(CPU_EQUAL(&before, &after));
 }
 
+// Under `--threads 1` (a global_control of one thread) every tile runs on
+// the caller, also after start_workers: its enqueued tasks woke a worker
+// anyway (TBB's mandatory concurrency), which took part in a quarter of the
+// one-thread renders. And the tile policy counts one thread, not the arena's.
+TEST(Tiles, OneThreadMeansOneThread) {
+    tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+    EXPECT_EQ(worker_threads(), 1);
+    std::mutex m;
+    std::set<int> slots;
+    for (int attempt = 0; attempt < 10; ++attempt) {
+        ThreadsSpread::start_workers();
+        for_each_tile(TileGrid{32 * 16, 16, 16}, [&](int, int slot) {
+            const auto end = std::chrono::steady_clock::now() + std::chrono::microseconds(100);
+            while (std::chrono::steady_clock::now() < end) {
+            }
+            std::lock_guard lock(m);
+            slots.insert(slot);
+        });
+    }
+    EXPECT_EQ(slots, std::set<int>{0});
+}
+
 // A worker that has joined the arena before is already on a CPU of its own,
 // not the caller's, when it starts its first task of a loop: pinned by
 // ThreadsSpread before the loop wakes it, not by enter() once running.
