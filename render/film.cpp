@@ -53,28 +53,37 @@ Image Film::resolve() const {
 
 void Film::resolve(Image& out) const {
     if (out.width != sum_.width || out.height != sum_.height) out = Image(sum_.width, sum_.height);
-    for (int y = 0; y < sum_.height; ++y)
-        for (int x = 0; x < sum_.width; ++x) {
-            const int n = count_[std::size_t(y) * std::size_t(sum_.width) + std::size_t(x)];
-            out.set(x, y, n > 0 ? sum_.at(x, y) / float(n) : Vec3f{});
-        }
+    resolve(0, 0, sum_.width, sum_.height, out);
 }
 
-double Film::noise_rms() const {
-    double total = 0;
-    std::size_t values = 0;
-    for (int y = 0; y < sum_.height; ++y)
-        for (int x = 0; x < sum_.width; ++x) {
+FilmNoise Film::resolve(int x0, int y0, int x1, int y1, Image& out) const { return region(x0, y0, x1, y1, &out); }
+
+FilmNoise Film::region(int x0, int y0, int x1, int y1, Image* out) const {
+    FilmNoise noise;
+    // Two partial sums, so that the additions of consecutive pixels overlap.
+    double partial[2] = {0, 0};
+    for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) {
             const int n = count_[std::size_t(y) * std::size_t(sum_.width) + std::size_t(x)];
+            const Vec3f sum = sum_.at(x, y);
+            if (out) out->set(x, y, n > 0 ? sum / float(n) : Vec3f{});
             if (n < 2) continue;
+            // Per channel (sum_sq - sum^2 / n) / (n - 1), the sample
+            // variance, over n: the variance of the mean.
+            const Vec3f sq = sum_sq_.at(x, y);
+            const double inv_n = 1.0 / n, inv_var_n = 1.0 / (double(n - 1) * n);
+            double v = 0;
             for (int c = 0; c < 3; ++c) {
-                const double mean = double(sum_.at(x, y)[c]) / n;
-                const double var = std::max(0.0, (double(sum_sq_.at(x, y)[c]) - n * mean * mean) / (n - 1));
-                total += var / n;
-                ++values;
+                const double s = sum[c];
+                v += std::max(0.0, double(sq[c]) - s * s * inv_n) * inv_var_n;
             }
+            partial[x & 1] += v;
+            noise.values += 3;
         }
-    return values ? std::sqrt(total / double(values)) : 0.0;
+    noise.sum = partial[0] + partial[1];
+    return noise;
 }
+
+double Film::noise_rms() const { return region(0, 0, sum_.width, sum_.height, nullptr).rms(); }
 
 }  // namespace raypack

@@ -3,6 +3,8 @@
 // importance-sampled as pbrt-v4 does: sample positions follow the filter's
 // shape and every sample weighs the same) and the average of a pixel's
 // samples.
+#include <cmath>
+#include <cstdint>
 #include <optional>
 #include <span>
 #include <string_view>
@@ -33,6 +35,20 @@ inline Sample2 filter_offset(PixelFilter filter, Sample2 u) {
     return shaped_filter_offset(filter, u);
 }
 
+/// Film::noise_rms's sum over part of the film: per pixel and channel, the
+/// sample variance of the pixel's mean. Parts add up in a fixed order (a
+/// render's tiles in tile order), so the figure does not depend on threads.
+struct FilmNoise {
+    double sum = 0;
+    std::uint64_t values = 0;
+    FilmNoise& operator+=(const FilmNoise& o) {
+        sum += o.sum;
+        values += o.values;
+        return *this;
+    }
+    double rms() const { return values ? std::sqrt(sum / double(values)) : 0.0; }
+};
+
 /// Sums of samples per pixel (and of their squares), resolved into their
 /// average and an estimate of its noise.
 class Film {
@@ -54,6 +70,10 @@ public:
     Image resolve() const;
     /// The same into `out`, whose memory is reused when it has the film's size.
     void resolve(Image& out) const;
+    /// The pixels [x0, x1) x [y0, y1) into `out` (of the film's size), and
+    /// their part of noise_rms: a render resolves each tile once its
+    /// samples are in, on the tile's thread.
+    FilmNoise resolve(int x0, int y0, int x1, int y1, Image& out) const;
     bool has_size(int width, int height) const { return sum_.width == width && sum_.height == height; }
     /// The standard error of each pixel's mean (sample variance / count,
     /// per channel), as the root mean square over pixels and channels: how
@@ -61,6 +81,9 @@ public:
     double noise_rms() const;
 
 private:
+    /// resolve's loop; `out` may be null (noise alone).
+    FilmNoise region(int x0, int y0, int x1, int y1, Image* out) const;
+
     Image sum_, sum_sq_;
     std::vector<int> count_;
 };

@@ -759,6 +759,8 @@ RenderStats render_path(const Scene& scene, const Accel& accel, const WhittedOpt
     Film& film = options.film && options.film->has_size(options.width, options.height)
                      ? *options.film
                      : own_film.emplace(options.width, options.height);
+    if (image.width != options.width || image.height != options.height) image = Image(options.width, options.height);
+    std::vector<FilmNoise> tile_noise(std::size_t(grid.count()));  // summed in tile order
     for_each_tile(grid, [&](int tile, int slot) {
         Scratch& s = scratch.at(slot);
         grid.pixels(tile, s.pixels);
@@ -778,11 +780,15 @@ RenderStats render_path(const Scene& scene, const Accel& accel, const WhittedOpt
                 i += std::size_t(k1 - k0);
             }
         }
+        // The tile's pixels are final: resolved on the tile's thread.
+        const auto [x0, y0, x1, y1] = grid.rect(tile);
+        tile_noise[std::size_t(tile)] = film.resolve(x0, y0, x1, y1, image);
         progress.add(s.pixels.size());
     });
-    film.resolve(image);
     RenderStats stats;
-    stats.noise_rms = film.noise_rms();
+    FilmNoise noise;
+    for (const FilmNoise& n : tile_noise) noise += n;
+    stats.noise_rms = noise.rms();
     scratch.for_each([&](const Scratch& s) { stats += s.stats; });
     stats.render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return stats;

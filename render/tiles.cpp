@@ -10,11 +10,15 @@
 
 namespace raypack {
 
+TileGrid::Rect TileGrid::rect(int index) const {
+    const int x0 = (index % tiles_x()) * tile, y0 = (index / tiles_x()) * tile;
+    return {x0, y0, std::min(x0 + tile, width), std::min(y0 + tile, height)};
+}
+
 void TileGrid::pixels(int index, std::vector<PixelXY>& out) const {
     constexpr int kBlock = 4;
     out.clear();
-    const int x0 = (index % tiles_x()) * tile, y0 = (index / tiles_x()) * tile;
-    const int x1 = std::min(x0 + tile, width), y1 = std::min(y0 + tile, height);
+    const auto [x0, y0, x1, y1] = rect(index);
     for (int by = y0; by < y1; by += kBlock)
         for (int bx = x0; bx < x1; bx += kBlock)
             for (int y = by; y < std::min(by + kBlock, y1); ++y)

@@ -21,6 +21,11 @@ struct TileGrid {
     int count() const { return tiles_x() * tiles_y(); }
     /// Pixels of tile `index`, row-major over 4 x 4 blocks, each block row-major.
     void pixels(int index, std::vector<PixelXY>& out) const;
+    /// Tile `index` as the pixels [x0, x1) x [y0, y1).
+    struct Rect {
+        int x0, y0, x1, y1;
+    };
+    Rect rect(int index) const;
 };
 
 /// Calls `render_tile(index, slot)` for every tile, in parallel; `slot` is

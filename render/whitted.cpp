@@ -635,8 +635,8 @@ RenderStats render_adaptive(const Scene& scene, const Accel& accel, const Whitte
     image = Image(options.width, options.height);
     for_each_tile(grid, [&](int tile, int slot) {
         Scratch& s = scratch.at(slot);
-        const int x0 = (tile % grid.tiles_x()) * grid.tile, y0 = (tile / grid.tiles_x()) * grid.tile;
-        const int x1 = std::min(x0 + grid.tile, options.width), y1 = std::min(y0 + grid.tile, options.height);
+        const TileGrid::Rect r = grid.rect(tile);
+        const int x0 = r.x0, y0 = r.y0, x1 = r.x1, y1 = r.y1;  // named variables: the lambdas below capture them
         // Traces points (fine coordinates) as one batch; colours in s.tree.color.
         std::vector<std::pair<std::int64_t, std::int64_t>> batch;
         const auto trace_points = [&] {
@@ -748,11 +748,14 @@ RenderStats render_whitted(const Scene& scene, const Accel& accel, const Whitted
                    ? options.film
                    : &own_film.emplace(options.width, options.height);
     }
-    // One sample a pixel writes every pixel: an image of the right size
-    // from the caller is kept (the command line makes it before the build,
-    // so that its fresh pages are not faulted in on the render's clock).
-    else if (image.width != options.width || image.height != options.height)
-        image = Image(options.width, options.height);
+    // Every pixel is written, by the tile that holds it: an image of the
+    // right size from the caller is kept (the command line makes it before
+    // the build, so that its fresh pages are not faulted in on the
+    // render's clock).
+    if (image.width != options.width || image.height != options.height) image = Image(options.width, options.height);
+    // Sampled renders: each tile's part of the noise estimate, summed in
+    // tile order at the end.
+    std::vector<FilmNoise> tile_noise(film ? std::size_t(grid.count()) : 0);
     for_each_tile(grid, [&](int tile, int slot) {
         Scratch& s = scratch.at(slot);
         grid.pixels(tile, s.pixels);
@@ -788,12 +791,20 @@ RenderStats render_whitted(const Scene& scene, const Accel& accel, const Whitted
                 i += std::size_t(k1 - k0);
             }
         }
+        // The tile's samples are all in: its pixels resolve here, in
+        // parallel (after the loop they were 10-16% of a Cornell box's
+        // render at 4 samples, on one thread).
+        if (film) {
+            const auto [x0, y0, x1, y1] = grid.rect(tile);
+            tile_noise[std::size_t(tile)] = film->resolve(x0, y0, x1, y1, image);
+        }
         progress.add(s.pixels.size());
     });
     RenderStats stats;
     if (film) {
-        film->resolve(image);
-        stats.noise_rms = film->noise_rms();
+        FilmNoise noise;
+        for (const FilmNoise& n : tile_noise) noise += n;
+        stats.noise_rms = noise.rms();
     }
     scratch.for_each([&](const Scratch& s) { stats += s.stats; });
     stats.render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

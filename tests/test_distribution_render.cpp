@@ -239,15 +239,19 @@ TEST(DistributionRender, SameImageForAnyThreadCount) {
     o.width = o.height = 48;
     o.light_samples = 2;
     Image one, two;
+    RenderStats stats_one, stats_two;
     {
         const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
-        render_whitted(s, *accel, o, one);
+        stats_one = render_whitted(s, *accel, o, one);
     }
     {
         const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
-        render_whitted(s, *accel, o, two);
+        stats_two = render_whitted(s, *accel, o, two);
     }
     EXPECT_EQ(one.rgb, two.rgb);
+    // The noise estimate too: tiles resolve on their threads, and their
+    // parts add up in tile order.
+    EXPECT_EQ(stats_one.noise_rms, stats_two.noise_rms);
     // A film and an image the caller made beforehand (the command line's
     // way) take the samples and give the same image; a film of another size
     // is left alone.
@@ -257,6 +261,8 @@ TEST(DistributionRender, SameImageForAnyThreadCount) {
     render_whitted(s, *accel, o, three);
     EXPECT_EQ(three.rgb, one.rgb);
     EXPECT_EQ(film.resolve().rgb, one.rgb);
+    EXPECT_NEAR(film.noise_rms(), stats_one.noise_rms, 1e-12 * stats_one.noise_rms);  // whole film at once
+    EXPECT_GT(stats_one.noise_rms, 0.0);
     o.film = &other;
     render_whitted(s, *accel, o, four);
     EXPECT_EQ(four.rgb, one.rgb);

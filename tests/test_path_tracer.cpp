@@ -120,15 +120,18 @@ TEST(PathTracer, SameImageForAnyThreadCount) {
     WhittedOptions o = sampled(40, 4);
     o.sampler = SamplerKind::Sobol;
     Image one, two;
+    double noise_one = 0, noise_two = 0;
     {
         const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
-        render_path(s, *accel, o, PathOptions{}, one);
+        noise_one = render_path(s, *accel, o, PathOptions{}, one).noise_rms;
     }
     {
         const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
-        render_path(s, *accel, o, PathOptions{}, two);
+        noise_two = render_path(s, *accel, o, PathOptions{}, two).noise_rms;
     }
     EXPECT_EQ(one.rgb, two.rgb);
+    EXPECT_EQ(noise_one, noise_two);  // tiles' parts summed in tile order
+    EXPECT_GT(noise_one, 0.0);
     // A film and an image the caller made beforehand take the samples and
     // give the same image.
     Film film(o.width, o.height);
@@ -137,6 +140,7 @@ TEST(PathTracer, SameImageForAnyThreadCount) {
     render_path(s, *accel, o, PathOptions{}, three);
     EXPECT_EQ(three.rgb, one.rgb);
     EXPECT_EQ(film.resolve().rgb, one.rgb);
+    EXPECT_NEAR(film.noise_rms(), noise_one, 1e-12 * noise_one);
 }
 
 TEST(PathTracer, VerticesInLanesAreTheScalarVerticesBitForBit) {
