@@ -62,6 +62,10 @@ FilmNoise Film::region(int x0, int y0, int x1, int y1, Image* out) const {
     FilmNoise noise;
     // Two partial sums, so that the additions of consecutive pixels overlap.
     double partial[2] = {0, 0};
+    // Most pixels hold as many samples as their neighbours: the factors of
+    // the last count are reused instead of two double divisions a pixel.
+    int last = -1;
+    double inv_n = 0, inv_var_n = 0;
     for (int y = y0; y < y1; ++y)
         for (int x = x0; x < x1; ++x) {
             const int n = count_[std::size_t(y) * std::size_t(sum_.width) + std::size_t(x)];
@@ -71,7 +75,11 @@ FilmNoise Film::region(int x0, int y0, int x1, int y1, Image* out) const {
             // Per channel (sum_sq - sum^2 / n) / (n - 1), the sample
             // variance, over n: the variance of the mean.
             const Vec3f sq = sum_sq_.at(x, y);
-            const double inv_n = 1.0 / n, inv_var_n = 1.0 / (double(n - 1) * n);
+            if (n != last) {
+                last = n;
+                inv_n = 1.0 / n;
+                inv_var_n = 1.0 / (double(n - 1) * n);
+            }
             double v = 0;
             for (int c = 0; c < 3; ++c) {
                 const double s = sum[c];
