@@ -42,6 +42,24 @@ inline void transpose_rays8(const Rayf* rays, __m256 (&row)[8]) {
     transpose8x8(row);
 }
 
+/// 8 consecutive hits as four rows of 8 lanes (t, prim's bits, u, v): the
+/// inverse of store_hits8.
+inline void load_hits8(const Hitf* hits, __m256 (&row)[4]) {
+    const float* in = reinterpret_cast<const float*>(hits);
+    // Hits 0-1 | 4-5 and 2-3 | 6-7 in the two 128-bit halves.
+    const __m256 l0 = _mm256_loadu_ps(in), l1 = _mm256_loadu_ps(in + 8);
+    const __m256 l2 = _mm256_loadu_ps(in + 16), l3 = _mm256_loadu_ps(in + 24);
+    const __m256 e = _mm256_permute2f128_ps(l0, l2, 0x20), f = _mm256_permute2f128_ps(l0, l2, 0x31);
+    const __m256 g = _mm256_permute2f128_ps(l1, l3, 0x20), k = _mm256_permute2f128_ps(l1, l3, 0x31);
+    // Per 128-bit half h: e = hit h*4+0, f = +1, g = +2, k = +3 (t, p, u, v each).
+    const __m256 a = _mm256_unpacklo_ps(e, f), b = _mm256_unpackhi_ps(e, f);  // t0 t1 p0 p1 | u0 u1 v0 v1
+    const __m256 c = _mm256_unpacklo_ps(g, k), d = _mm256_unpackhi_ps(g, k);
+    row[0] = _mm256_castpd_ps(_mm256_unpacklo_pd(_mm256_castps_pd(a), _mm256_castps_pd(c)));
+    row[1] = _mm256_castpd_ps(_mm256_unpackhi_pd(_mm256_castps_pd(a), _mm256_castps_pd(c)));
+    row[2] = _mm256_castpd_ps(_mm256_unpacklo_pd(_mm256_castps_pd(b), _mm256_castps_pd(d)));
+    row[3] = _mm256_castpd_ps(_mm256_unpackhi_pd(_mm256_castps_pd(b), _mm256_castps_pd(d)));
+}
+
 /// The other way: rows of fields (transpose_rays8's) as 8 consecutive rays.
 inline void store_rays8(__m256 (&row)[8], Rayf* rays) {
     transpose8x8(row);

@@ -6,6 +6,7 @@
 // the shading loop's time (store forwarding and dependent loads per hit).
 #include <cstdint>
 
+#include "kernels/ray_transpose.h"
 #include "kernels/simd.h"
 #include "render/gather_lanes.h"
 #include "render/surface.h"
@@ -24,15 +25,84 @@ struct SurfaceLanes {
     /// `lanes` (found hits; at the shutter's opening). Lanes outside `lanes`
     /// hold garbage, but their `index` must still be a valid ray.
     void gather(const SurfaceTable& table, const Rayf* rays, const Hitf* hits, const I& index, std::uint32_t lanes) {
-        static_assert(sizeof(Hitf) == 16 && sizeof(Rayf) == 32 && sizeof(SurfaceTable::Record) == 16);
+        static_assert(sizeof(Hitf) == 16 && sizeof(Rayf) == 32);
+        const auto* hit_words = reinterpret_cast<const float*>(hits);
+        const auto* ray_words = reinterpret_cast<const float*>(rays);
+        const I hit4 = shift_left<K>(index, 2), ray8 = shift_left<K>(index, 3);
+        HitFields h;
+        h.prim = gather_ints<K>(reinterpret_cast<const std::int32_t*>(hits), hit4 + I(1));
+        h.t = gather_floats<K>(hit_words, hit4);
+        h.org = {gather_floats<K>(ray_words, ray8), gather_floats<K>(ray_words, ray8 + I(1)),
+                 gather_floats<K>(ray_words, ray8 + I(2))};
+        h.dir = {gather_floats<K>(ray_words, ray8 + I(3)), gather_floats<K>(ray_words, ray8 + I(4)),
+                 gather_floats<K>(ray_words, ray8 + I(5))};
+        surfaces(table, rays, hits, index, lanes, h);
+    }
+
+    /// gather() for the K consecutive hits and rays first, first + 1 ...
+    /// (index[l] = first + l): loaded whole and transposed in registers
+    /// instead of eight gathers (a Cornell box's 4-sample render 3% faster,
+    /// gears 1.5%).
+    void load(const SurfaceTable& table, const Rayf* rays, const Hitf* hits, std::size_t first, const I& index,
+              std::uint32_t lanes) {
+#if defined(__AVX2__)
+        if constexpr (K == 8 || K == 16) {
+            __m256 ray_rows[2][8], hit_rows[2][4];
+            for (int q = 0; q < K / 8; ++q) {
+                transpose_rays8(rays + first + std::size_t(8 * q), ray_rows[q]);
+                load_hits8(hits + first + std::size_t(8 * q), hit_rows[q]);
+            }
+            auto ray_field = [&](int f) -> F {
+                if constexpr (K == 8) return F(ray_rows[0][f]);
+#if defined(__AVX512F__)
+                else return F(_mm512_insertf32x8(_mm512_castps256_ps512(ray_rows[0][f]), ray_rows[1][f], 1));
+#endif
+            };
+            auto hit_field = [&](int f) -> F {
+                if constexpr (K == 8) return F(hit_rows[0][f]);
+#if defined(__AVX512F__)
+                else return F(_mm512_insertf32x8(_mm512_castps256_ps512(hit_rows[0][f]), hit_rows[1][f], 1));
+#endif
+            };
+            HitFields h;
+            h.org = {ray_field(0), ray_field(1), ray_field(2)};
+            h.dir = {ray_field(3), ray_field(4), ray_field(5)};
+            h.t = hit_field(0);
+            if constexpr (K == 8) h.prim = I(_mm256_castps_si256(hit_field(1)));
+#if defined(__AVX512F__)
+            else h.prim = I(_mm512_castps_si512(hit_field(1)));
+#endif
+            h.u = hit_field(2);
+            h.v = hit_field(3);
+            h.has_uv = true;
+            surfaces(table, rays, hits, index, lanes, h);
+            return;
+        }
+#endif
+        gather(table, rays, hits, index, lanes);
+    }
+
+private:
+    /// What gather() reads of each lane's hit and ray.
+    struct HitFields {
+        I prim;
+        F t;
+        Vec3<F> org, dir;
+        bool has_uv = false;  ///< u, v read (else gathered where needed)
+        F u, v;
+    };
+
+    /// The surfaces from the lanes' hits and rays.
+    void surfaces(const SurfaceTable& table, const Rayf* rays, const Hitf* hits, const I& index, std::uint32_t lanes,
+                  const HitFields& in) {
+        static_assert(sizeof(SurfaceTable::Record) == 16);
         static_assert(sizeof(PrimRef) == 8 && sizeof(Vec3f) == 12);
         alignas(64) std::int32_t lane_bit[K];
         for (int l = 0; l < K; ++l) lane_bit[l] = std::int32_t(1u << l);
         const auto in_lanes = (I(std::int32_t(lanes)) & I::load_aligned(lane_bit)) != I(0);
         const auto* hit_words = reinterpret_cast<const float*>(hits);
-        const auto* ray_words = reinterpret_cast<const float*>(rays);
-        const I hit4 = shift_left<K>(index, 2), ray8 = shift_left<K>(index, 3);
-        const I prim = gather_ints<K>(reinterpret_cast<const std::int32_t*>(hits), hit4 + I(1));
+        const I hit4 = shift_left<K>(index, 2);
+        const I prim = in.prim;
         // Primitives inside instances have no record (prim >= records).
         const auto recorded = in_lanes & (prim >= I(0)) & (prim < I(std::int32_t(table.records_.size())));
         const std::uint32_t recorded_bits = int_mask_bits<K>(recorded);
@@ -56,13 +126,8 @@ struct SurfaceLanes {
         }
         material = xsimd::select(recorded, shift_right<K>(material_kind, int(SurfaceTable::kKindBits)), I(0));
         const I kind = material_kind & I(std::int32_t(SurfaceTable::kKindMask));
-        const F t = gather_floats<K>(hit_words, hit4);
-        const Vec3<F> org{gather_floats<K>(ray_words, ray8), gather_floats<K>(ray_words, ray8 + I(1)),
-                          gather_floats<K>(ray_words, ray8 + I(2))};
-        const Vec3<F> dir{gather_floats<K>(ray_words, ray8 + I(3)), gather_floats<K>(ray_words, ray8 + I(4)),
-                          gather_floats<K>(ray_words, ray8 + I(5))};
-        direction = dir;
-        point = org + dir * t;
+        direction = in.dir;
+        point = in.org + in.dir * in.t;
         geometric_normal = v;  // flat and smooth triangles
         shading_normal = v;    // flat triangles
         const std::uint32_t sphere = lanes & int_mask_bits<K>(recorded & (kind == I(SurfaceTable::kSphere)));
@@ -89,7 +154,8 @@ struct SurfaceLanes {
             const I tri3 = gather_ints<K>(reinterpret_cast<const std::int32_t*>(table.scene_.prims.data()),
                                           shift_left<K>(triangle, 1) + I(1)) *
                            I(3);
-            const F u = gather_floats<K>(hit_words, hit4 + I(2)), w2 = gather_floats<K>(hit_words, hit4 + I(3));
+            const F u = in.has_uv ? in.u : gather_floats<K>(hit_words, hit4 + I(2));
+            const F w2 = in.has_uv ? in.v : gather_floats<K>(hit_words, hit4 + I(3));
             const F w = F(1.0f) - u - w2;
             const auto vertex_normal = [&](const std::vector<Vec3f>& n) {
                 const auto* words = reinterpret_cast<const float*>(n.data());
@@ -110,8 +176,8 @@ struct SurfaceLanes {
             const I cone_index = gather_ints<K>(reinterpret_cast<const std::int32_t*>(table.scene_.prims.data()),
                                            shift_left<K>(any_cone, 1) + I(1));
             const I index3 = cone_index * I(3);
-            const auto end = [&](const std::vector<Vec3f>& v) {
-                const auto* words = reinterpret_cast<const float*>(v.data());
+            const auto end = [&](const std::vector<Vec3f>& ends) {
+                const auto* words = reinterpret_cast<const float*>(ends.data());
                 return Vec3<F>{gather_floats<K>(words, index3), gather_floats<K>(words, index3 + I(1)),
                                gather_floats<K>(words, index3 + I(2))};
             };

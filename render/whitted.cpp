@@ -382,7 +382,8 @@ private:
             // Lanes past the last ray read the last one (masked off).
             const I last(std::int32_t(i0) + count - 1), index = I(std::int32_t(i0)) + lanes;
             const I clamped = xsimd::select(index > last, last, index);
-            surf.gather(surfaces_, tree.rays.data(), tree.hits.data(), clamped, found);
+            if (count == K) surf.load(surfaces_, tree.rays.data(), tree.hits.data(), i0, clamped, found);
+            else surf.gather(surfaces_, tree.rays.data(), tree.hits.data(), clamped, found);
             surf.material.store_aligned(material);
             // Most blocks lie on one material: its terms once.
             const std::int32_t first = first_lane<K>(surf.material, found);

@@ -83,39 +83,45 @@ TEST_P(SurfaceTableTest, SameSurfacesAsSurfaceAt) {
     EXPECT_GT(compared, 1000u);
 }
 
+// Gathered lane by lane and loaded whole (consecutive rays, transposed in
+// registers): the same bits.
 TEST_P(SurfaceTableTest, LanesHoldTheTablesBits) {
     constexpr int K = kShadeLanes;
     using I = vint<K>;
     SurfaceLanes<K> lanes;
-    std::size_t compared = 0;
-    for (std::size_t i0 = 0; i0 + K <= rays.size(); i0 += K) {
-        alignas(64) std::int32_t index[K];
-        std::uint32_t found = 0;
-        for (int l = 0; l < K; ++l) {
-            index[l] = std::int32_t(i0) + l;
-            found |= std::uint32_t(hits[i0 + std::size_t(l)].found()) << l;
+    for (const bool consecutive : {false, true}) {
+        SCOPED_TRACE(consecutive ? "loaded" : "gathered");
+        std::size_t compared = 0;
+        for (std::size_t i0 = 0; i0 + K <= rays.size(); i0 += K) {
+            alignas(64) std::int32_t index[K];
+            std::uint32_t found = 0;
+            for (int l = 0; l < K; ++l) {
+                index[l] = std::int32_t(i0) + l;
+                found |= std::uint32_t(hits[i0 + std::size_t(l)].found()) << l;
+            }
+            if (found == 0) continue;
+            if (consecutive) lanes.load(*table, rays.data(), hits.data(), i0, I::load_aligned(index), found);
+            else lanes.gather(*table, rays.data(), hits.data(), I::load_aligned(index), found);
+            alignas(64) float lane[9][K];
+            alignas(64) std::int32_t material[K];
+            for (int a = 0; a < 3; ++a) {
+                lanes.point[a].store_aligned(lane[a]);
+                lanes.geometric_normal[a].store_aligned(lane[3 + a]);
+                lanes.shading_normal[a].store_aligned(lane[6 + a]);
+            }
+            lanes.material.store_aligned(material);
+            for (int l = 0; l < K; ++l) {
+                if (!((found >> l) & 1u)) continue;
+                const Surface want = table->at(rays[i0 + std::size_t(l)], hits[i0 + std::size_t(l)]);
+                expect_same_bits({lane[0][l], lane[1][l], lane[2][l]}, want.point, "point");
+                expect_same_bits({lane[3][l], lane[4][l], lane[5][l]}, want.geometric_normal, "geometric normal");
+                expect_same_bits({lane[6][l], lane[7][l], lane[8][l]}, want.shading_normal, "shading normal");
+                EXPECT_EQ(std::uint32_t(material[l]), want.material);
+                ++compared;
+            }
         }
-        if (found == 0) continue;
-        lanes.gather(*table, rays.data(), hits.data(), I::load_aligned(index), found);
-        alignas(64) float lane[9][K];
-        alignas(64) std::int32_t material[K];
-        for (int a = 0; a < 3; ++a) {
-            lanes.point[a].store_aligned(lane[a]);
-            lanes.geometric_normal[a].store_aligned(lane[3 + a]);
-            lanes.shading_normal[a].store_aligned(lane[6 + a]);
-        }
-        lanes.material.store_aligned(material);
-        for (int l = 0; l < K; ++l) {
-            if (!((found >> l) & 1u)) continue;
-            const Surface want = table->at(rays[i0 + std::size_t(l)], hits[i0 + std::size_t(l)]);
-            expect_same_bits({lane[0][l], lane[1][l], lane[2][l]}, want.point, "point");
-            expect_same_bits({lane[3][l], lane[4][l], lane[5][l]}, want.geometric_normal, "geometric normal");
-            expect_same_bits({lane[6][l], lane[7][l], lane[8][l]}, want.shading_normal, "shading normal");
-            EXPECT_EQ(std::uint32_t(material[l]), want.material);
-            ++compared;
-        }
+        EXPECT_GT(compared, 1000u);
     }
-    EXPECT_GT(compared, 1000u);
 }
 
 INSTANTIATE_TEST_SUITE_P(SpdScenes, SurfaceTableTest,
