@@ -89,6 +89,16 @@ void reserve_heap_in_large_pages() {
     // keeps what is freed.
     mallopt(M_MMAP_THRESHOLD, 32 << 20);
     mallopt(M_TRIM_THRESHOLD, 1 << 30);
+    // One arena for every thread: glibc gives each new thread an arena of
+    // its own, whose fresh pages (no huge pages, not populated) fault in one
+    // by one as a render's worker grows its scratch memory, which the main
+    // thread, on the heap prepared below, does not pay. At 2 threads with
+    // tiles of 64, balls rendered in 47 ms with an arena per thread and 41
+    // with one (1,500 fewer page faults); tetra (4 ms) about 4% slower.
+    // The parallel loops allocate little (their scratch is reused), and
+    // small blocks come from each thread's cache (tcache) without the
+    // arena's lock.
+    mallopt(M_ARENA_MAX, 1);
     // Grow the heap once by kHeapReserve and ask for huge pages there, as
     // Embree does for its BVH memory and as glibc's glibc.malloc.hugetlb=1
     // tunable would, without needing the environment variable.

@@ -27,8 +27,6 @@ void TileGrid::pixels(int index, std::vector<PixelXY>& out) const {
 
 int worker_slots() { return tbb::this_task_arena::max_concurrency(); }
 
-int worker_threads() { return ThreadsSpread::threads(); }
-
 void for_each_tile(const TileGrid& grid, const std::function<void(int tile, int slot)>& render_tile) {
     ThreadsSpread spread;
     // One tile per task: tiles cost very different amounts (sky against

@@ -36,10 +36,6 @@ void for_each_tile(const TileGrid& grid, const std::function<void(int tile, int 
 /// Upper bound of the slots for_each_tile passes (the TBB arena's workers).
 int worker_slots();
 
-/// Threads for_each_tile runs on now: worker_slots() within the limit of
-/// `--threads` (a tbb::global_control).
-int worker_threads();
-
 /// One scratch object per worker slot of for_each_tile, made on first use,
 /// so that each worker reuses its memory and keeps its own counters.
 template <class T>
@@ -48,17 +44,23 @@ public:
     PerWorker() : items_(static_cast<std::size_t>(worker_slots())) {}
     T& at(int slot) {
         auto& p = items_[std::size_t(slot)];
-        if (!p) p = std::make_unique<T>();
-        return *p;
+        if (!p) p = std::make_unique<Padded>();
+        return p->value;
     }
     template <class F>
     void for_each(F f) const {
         for (const auto& p : items_)
-            if (p) f(*p);
+            if (p) f(p->value);
     }
 
 private:
-    std::vector<std::unique_ptr<T>> items_;
+    /// Each worker's object on cache lines of its own: the threads share
+    /// one heap (app/heap_pages.cpp), where two objects made one after the
+    /// other would share a line, and the counters in them are written per ray.
+    struct alignas(64) Padded {
+        T value;
+    };
+    std::vector<std::unique_ptr<Padded>> items_;
 };
 
 /// Pixels finished so far, reported to an optional callback after each tile.

@@ -91,12 +91,12 @@ struct RenderStats {
 /// or by default 16, except where streams will carry the reflections (one
 /// sample a pixel, a structure with streams, and spheres and cones that
 /// reflect or transmit making up half the scene or more: rings, balls),
-/// whose batches want to be large: 64 at one thread (rings and balls 1.28x
-/// and 1.24x faster than in tiles of 16), 32 with more threads (at 64, the
-/// two-thread renders spread unevenly: balls 2T/1T 1.6x against 2.1x at
-/// 32). Tiles of 64 everywhere were 2-4% slower at one thread on gears,
-/// mount and teapot, and the short renders lost much of two threads'
-/// speed-up (tetra 1.63x -> 1.28x, mount 1.76x -> 1.12x).
+/// whose batches want to be large: 64 (rings and balls 1.28x and 1.24x
+/// faster than in tiles of 16 at one thread; at two, 4-9% faster than 32
+/// once the threads share one heap, app/heap_pages.cpp). Tiles of 64
+/// everywhere were 2-4% slower at one thread on gears, mount and teapot,
+/// and the short renders lost much of two threads' speed-up (tetra 1.63x
+/// -> 1.28x, mount 1.76x -> 1.12x).
 TileGrid render_tiles(const Scene& scene, const WhittedOptions& options, const Accel& accel,
                       bool one_sample_a_pixel);
 

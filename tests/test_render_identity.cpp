@@ -3,7 +3,6 @@
 // counts, on every shared SPD scene, at several depths, packet widths and
 // offset policies.
 #include <gtest/gtest.h>
-#include <tbb/global_control.h>
 
 #include <string>
 
@@ -63,13 +62,7 @@ TEST(RenderTiles, LargerTilesWhereStreamsCarryTheReflections) {
         const auto accel = build_accel(scene, accel_config("bvh4"));
         const bool curved = std::string(name) == "balls" || std::string(name) == "rings";
         SCOPED_TRACE(name);
-        {
-            // One thread (`--threads 1`): 64, whatever the arena's size.
-            tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
-            EXPECT_EQ(render_tiles(scene, options, *accel, true).tile, curved && accel->supports_stream() ? 64 : 16);
-        }
-        const int streamed = worker_threads() > 1 ? 32 : 64;
-        EXPECT_EQ(render_tiles(scene, options, *accel, true).tile, curved && accel->supports_stream() ? streamed : 16);
+        EXPECT_EQ(render_tiles(scene, options, *accel, true).tile, curved && accel->supports_stream() ? 64 : 16);
         EXPECT_EQ(render_tiles(scene, options, *accel, false).tile, 16);
         options.tile_size = 8;
         EXPECT_EQ(render_tiles(scene, options, *accel, true).tile, 8);

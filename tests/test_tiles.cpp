@@ -80,10 +80,10 @@ TEST(Tiles, ThreadsRunOnCpusOfTheirOwn) {
 // Under `--threads 1` (a global_control of one thread) every tile runs on
 // the caller, also after start_workers: its enqueued tasks woke a worker
 // anyway (TBB's mandatory concurrency), which took part in a quarter of the
-// one-thread renders. And the tile policy counts one thread, not the arena's.
+// one-thread renders.
 TEST(Tiles, OneThreadMeansOneThread) {
     tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
-    EXPECT_EQ(worker_threads(), 1);
+    EXPECT_EQ(ThreadsSpread::threads(), 1);
     std::mutex m;
     std::set<int> slots;
     for (int attempt = 0; attempt < 10; ++attempt) {
