@@ -91,6 +91,15 @@ struct AreaLightLanes : LightLanes {
                 for (int a = 0; a < 3; ++a) store_lanes(out_k.point[a], point[a]);
             }
             if (any_lit == 0) continue;
+            if (samples == 1) {
+                // One sample a point: the points' order is the lanes'.
+                const SampleLanes& in = lanes[0];
+                const Vec3<F> target{load_lanes<F>(in.point[0]), load_lanes<F>(in.point[1]), load_lanes<F>(in.point[2])};
+                const std::size_t n = std::size_t(std::popcount(in.lit));
+                emit(pts, j, in.lit, above, target, in.contribution, offset.tnear(), out.append(n));
+                emitted += n;
+                continue;
+            }
             std::size_t n = 0;
             for (int k = 0; k < samples; ++k) n += std::size_t(std::popcount(lanes[std::size_t(k)].lit));
             const ShadowQueue::Run run = out.append(n);

@@ -31,16 +31,9 @@ struct PointLightLanes : LightLanes {
             const F scale = F(intensity) * atten;
             const Vec3<F> light_color{F(light.color.x) * scale, F(light.color.y) * scale, F(light.color.z) * scale};
             direct(pts, j, faces, ns, l, ns_l, view, light_color, contribution);
-            const ShadowQueue::Run run = out.append(std::size_t(std::popcount(faces)));
-            std::size_t k = 0;
-            for (std::uint32_t bits = faces; bits != 0; bits &= bits - 1, ++k) {
-                const int i = std::countr_zero(bits);
-                const std::size_t p = j + std::size_t(i);
-                spawn_ray_to(pts.above(p), light.position, offset, run.rays[k]);
-                run.owner[k] = pts.ray_[p];
-                run.contribution[k] = {contribution[0][i], contribution[1][i], contribution[2][i]};
-            }
-            emitted += k;
+            const std::size_t n = std::size_t(std::popcount(faces));
+            emit(pts, j, faces, above, position, contribution, offset.tnear(), out.append(n));
+            emitted += n;
         }
         return emitted;
     }
