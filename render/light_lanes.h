@@ -29,8 +29,8 @@ struct LightLanes {
     /// `lit`, toward `target` (per lane), in lane order into `run` (which
     /// holds popcount(lit) entries): spawn_ray_to's rays, their owners and
     /// the lanes' contributions. The lit lanes packed together, then written
-    /// as rays eight at a time through a transpose: ray by ray, the scalar
-    /// stores were most of the light loops' own time.
+    /// as rays eight at a time through a transpose (field by field from
+    /// each lane before: the Cornell box's distribution render 5% slower).
     static void emit(const ShadingPoints& pts, std::size_t j, std::uint32_t lit, const Vec3<F>& above,
                      const Vec3<F>& target, const float (&contribution)[3][K], float tnear, ShadowQueue::Run run) {
         const int n = std::popcount(lit);
