@@ -52,18 +52,15 @@ struct SurfaceLanes {
                 transpose_rays8(rays + first + std::size_t(8 * q), ray_rows[q]);
                 load_hits8(hits + first + std::size_t(8 * q), hit_rows[q]);
             }
-            auto ray_field = [&](int f) -> F {
-                if constexpr (K == 8) return F(ray_rows[0][f]);
+            // Lanes 0-7 from the first eight, 8-15 from the second.
+            auto field = [&](const __m256& lo, [[maybe_unused]] const __m256& hi) -> F {
+                if constexpr (K == 8) return F(lo);
 #if defined(__AVX512F__)
-                else return F(_mm512_insertf32x8(_mm512_castps256_ps512(ray_rows[0][f]), ray_rows[1][f], 1));
+                else return F(_mm512_insertf32x8(_mm512_castps256_ps512(lo), hi, 1));
 #endif
             };
-            auto hit_field = [&](int f) -> F {
-                if constexpr (K == 8) return F(hit_rows[0][f]);
-#if defined(__AVX512F__)
-                else return F(_mm512_insertf32x8(_mm512_castps256_ps512(hit_rows[0][f]), hit_rows[1][f], 1));
-#endif
-            };
+            auto ray_field = [&](int f) { return field(ray_rows[0][f], ray_rows[1][f]); };
+            auto hit_field = [&](int f) { return field(hit_rows[0][f], hit_rows[1][f]); };
             HitFields h;
             h.org = {ray_field(0), ray_field(1), ray_field(2)};
             h.dir = {ray_field(3), ray_field(4), ray_field(5)};
