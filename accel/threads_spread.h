@@ -32,8 +32,9 @@ public:
     void enter();
 
     /// Lets TBB's workers run a task now, without waiting for them, so
-    /// that the first loop finds them known (call early, e.g. before a
-    /// scene loads). Nothing at one thread.
+    /// that the first loop finds them known, on the CPUs it will want and
+    /// with their stacks mapped (call early, e.g. before a scene loads).
+    /// Nothing at one thread.
     static void start_workers();
 
     /// Threads a parallel loop may run on now: the arena's concurrency
