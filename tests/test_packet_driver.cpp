@@ -38,7 +38,7 @@ void check_sized_groups() {
     std::vector<std::size_t> alone;
     std::size_t next = 0;  // the packet the next group or lone packet must start at
     trace_in_sized_groups<K, G, false>(
-        rays, hits, RcpMethod::Exact, group_size,
+        rays, std::span(hits), RcpMethod::Exact, group_size,
         [&](RayPacket<K>& ray, HitPacket<K>& hit, vmask<K> valid, vmask<K>&) {
             EXPECT_EQ(place(ray), next);
             EXPECT_EQ(group_size(LoadedPacket<K>{ray, hit, valid, valid, 0}), 0);

@@ -107,30 +107,28 @@ WidePacketConfig WideBvhAccel<N, M, Test>::packet_config(int width) const {
 }
 
 template <int N, int M, NodeTest Test>
-template <bool AnyHit>
-void WideBvhAccel<N, M, Test>::trace_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
+void WideBvhAccel<N, M, Test>::intersect_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
+    if (width == 1 || !supports_packet(width)) return intersect(rays, hits);
     if constexpr (kPackets) {
         const WidePacketConfig& c = packet_config_[packet_slot(width)];
         return with_packet_width(width, stats_.name, [&]<int K>() {
-            wide_trace_packets<N, M, K, AnyHit>(bvh_, *scene_, kernels_, c, rays, hits);
+            wide_trace_packets<N, M, K>(bvh_, *scene_, kernels_, c, rays, hits);
         });
     }
     throw std::invalid_argument(stats_.name + ": packets of " + std::to_string(width) + " are not compiled in");
 }
 
 template <int N, int M, NodeTest Test>
-void WideBvhAccel<N, M, Test>::intersect_packets(int width, std::span<const Rayf> rays, std::span<Hitf> hits) const {
-    if (width == 1 || !supports_packet(width)) return intersect(rays, hits);
-    trace_packets<false>(width, rays, hits);
-}
-
-template <int N, int M, NodeTest Test>
 void WideBvhAccel<N, M, Test>::occluded_packets(int width, std::span<const Rayf> rays,
                                                 std::span<std::uint8_t> occluded) const {
     if (width == 1 || !supports_packet(width)) return this->occluded(rays, occluded);
-    occlusion_in_slices(rays, occluded, [&](std::span<const Rayf> slice, std::span<Hitf> hits) {
-        trace_packets<true>(width, slice, hits);
-    });
+    if constexpr (kPackets) {
+        const WidePacketConfig& c = packet_config_[packet_slot(width)];
+        return with_packet_width(width, stats_.name, [&]<int K>() {
+            wide_occluded_packets<N, M, K>(bvh_, *scene_, kernels_, c, rays, occluded);
+        });
+    }
+    throw std::invalid_argument(stats_.name + ": packets of " + std::to_string(width) + " are not compiled in");
 }
 
 /// Below this many rays a batch goes as packets: too few to fill the lists.

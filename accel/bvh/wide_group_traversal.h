@@ -414,11 +414,15 @@ void trace_group(const WideBvh<N, M>& bvh, const PacketKernels<K>& pk, int switc
 
 namespace raypack {
 
-template <int N, int M, int K, bool AnyHit>
-void wide_trace_packets(const WideBvh<N, M>& bvh, const Scene& scene, KernelChoice kernels,
-                        const WidePacketConfig& config, std::span<const Rayf> rays, std::span<Hitf> hits) {
+namespace wide_packet_detail {
+
+/// wide_trace_packets (AnyHit false, `hits` a std::span<Hitf>) and
+/// wide_occluded_packets (true, a std::span<std::uint8_t>).
+template <int N, int M, int K, bool AnyHit, class Answers>
+void trace_packets_into(const WideBvh<N, M>& bvh, const Scene& scene, KernelChoice kernels,
+                        const WidePacketConfig& config, std::span<const Rayf> rays, Answers hits) {
     if (bvh.nodes.empty()) {
-        for (auto& h : hits) h = Hitf{};
+        for (auto& h : hits) h = {};
         return;
     }
     const wide_packet_detail::PacketKernels<K> pk{kernels, {&scene, kernels}, {&scene, kernels}};
@@ -462,6 +466,21 @@ void wide_trace_packets(const WideBvh<N, M>& bvh, const Scene& scene, KernelChoi
         case TriangleMethod::Watertight: return run.template operator()<TriangleMethod::Watertight, false>();
         case TriangleMethod::Plane: return run.template operator()<TriangleMethod::Plane, false>();
     }
+}
+
+}  // namespace wide_packet_detail
+
+template <int N, int M, int K>
+void wide_trace_packets(const WideBvh<N, M>& bvh, const Scene& scene, KernelChoice kernels,
+                        const WidePacketConfig& config, std::span<const Rayf> rays, std::span<Hitf> hits) {
+    wide_packet_detail::trace_packets_into<N, M, K, false>(bvh, scene, kernels, config, rays, hits);
+}
+
+template <int N, int M, int K>
+void wide_occluded_packets(const WideBvh<N, M>& bvh, const Scene& scene, KernelChoice kernels,
+                           const WidePacketConfig& config, std::span<const Rayf> rays,
+                           std::span<std::uint8_t> occluded) {
+    wide_packet_detail::trace_packets_into<N, M, K, true>(bvh, scene, kernels, config, rays, occluded);
 }
 
 }  // namespace raypack

@@ -64,14 +64,21 @@ constexpr WidePacketConfig default_wide_packet_config(int n, int k) {
     return c;
 }
 
-/// Closest hits (AnyHit = false) or occlusion (AnyHit = true: hits[i].prim
-/// = 0 where occluded) of `rays` in packets of K consecutive rays. Defined
-/// for N = 4, 8 with M = 8 and the K that are compiled in (kWidthCompiled).
-/// `scene` is the one the tree was built over (--precision double tests
-/// leaves' primitives by id).
-template <int N, int M, int K, bool AnyHit>
+/// Closest hits of `rays` in packets of K consecutive rays. Defined for N =
+/// 4, 8 with M = 8 and the K that are compiled in (kWidthCompiled). `scene`
+/// is the one the tree was built over (--precision double tests leaves'
+/// primitives by id).
+template <int N, int M, int K>
 void wide_trace_packets(const WideBvh<N, M>& bvh, const Scene& scene, KernelChoice kernels,
                         const WidePacketConfig& config, std::span<const Rayf> rays, std::span<Hitf> hits);
+
+/// Occlusion of `rays` in packets of K, the same way: occluded[i] = 1 where
+/// occluded. The answers go straight from the lane masks into the bytes (a
+/// hit record per ray in between was a tenth of the query's time).
+template <int N, int M, int K>
+void wide_occluded_packets(const WideBvh<N, M>& bvh, const Scene& scene, KernelChoice kernels,
+                           const WidePacketConfig& config, std::span<const Rayf> rays,
+                           std::span<std::uint8_t> occluded);
 
 /// Whether this build walks streams: lists of rays are compacted 16 lanes
 /// at a time with AVX-512's compress.

@@ -5,22 +5,22 @@
 namespace raypack {
 
 #if defined(__SSE4_2__) && defined(__AVX2__)
-template void wide_trace_packets<4, 8, 4, false>(const WideBvh<4, 8>&, const Scene&, KernelChoice, const WidePacketConfig&,
-                                                  std::span<const Rayf>, std::span<Hitf>);
-template void wide_trace_packets<4, 8, 4, true>(const WideBvh<4, 8>&, const Scene&, KernelChoice, const WidePacketConfig&,
-                                                 std::span<const Rayf>, std::span<Hitf>);
+template void wide_trace_packets<4, 8, 4>(const WideBvh<4, 8>&, const Scene&, KernelChoice, const WidePacketConfig&,
+                                           std::span<const Rayf>, std::span<Hitf>);
+template void wide_occluded_packets<4, 8, 4>(const WideBvh<4, 8>&, const Scene&, KernelChoice, const WidePacketConfig&,
+                                              std::span<const Rayf>, std::span<std::uint8_t>);
 #endif
 #if defined(__AVX2__)
-template void wide_trace_packets<4, 8, 8, false>(const WideBvh<4, 8>&, const Scene&, KernelChoice, const WidePacketConfig&,
-                                                  std::span<const Rayf>, std::span<Hitf>);
-template void wide_trace_packets<4, 8, 8, true>(const WideBvh<4, 8>&, const Scene&, KernelChoice, const WidePacketConfig&,
-                                                 std::span<const Rayf>, std::span<Hitf>);
+template void wide_trace_packets<4, 8, 8>(const WideBvh<4, 8>&, const Scene&, KernelChoice, const WidePacketConfig&,
+                                           std::span<const Rayf>, std::span<Hitf>);
+template void wide_occluded_packets<4, 8, 8>(const WideBvh<4, 8>&, const Scene&, KernelChoice, const WidePacketConfig&,
+                                              std::span<const Rayf>, std::span<std::uint8_t>);
 #endif
 #if defined(__AVX512BW__)
-template void wide_trace_packets<4, 8, 16, false>(const WideBvh<4, 8>&, const Scene&, KernelChoice, const WidePacketConfig&,
-                                                   std::span<const Rayf>, std::span<Hitf>);
-template void wide_trace_packets<4, 8, 16, true>(const WideBvh<4, 8>&, const Scene&, KernelChoice, const WidePacketConfig&,
-                                                  std::span<const Rayf>, std::span<Hitf>);
+template void wide_trace_packets<4, 8, 16>(const WideBvh<4, 8>&, const Scene&, KernelChoice, const WidePacketConfig&,
+                                           std::span<const Rayf>, std::span<Hitf>);
+template void wide_occluded_packets<4, 8, 16>(const WideBvh<4, 8>&, const Scene&, KernelChoice, const WidePacketConfig&,
+                                              std::span<const Rayf>, std::span<std::uint8_t>);
 #endif
 
 }  // namespace raypack

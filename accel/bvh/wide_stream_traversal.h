@@ -390,11 +390,9 @@ void wide_trace_stream(const WideBvh<N, M>& bvh, const Scene& scene, KernelChoic
     if (bvh.nodes.empty() || kernels.precision == Precision::Double) {
         // No tree, or leaves tested by id: the packets' walk answers.
         if constexpr (AnyHit) {
-            occlusion_in_slices(rays, occluded, [&](std::span<const Rayf> slice, std::span<Hitf> h) {
-                wide_trace_packets<N, M, K, true>(bvh, scene, kernels, config, slice, h);
-            });
+            wide_occluded_packets<N, M, K>(bvh, scene, kernels, config, rays, occluded);
         } else {
-            wide_trace_packets<N, M, K, false>(bvh, scene, kernels, config, rays, hits);
+            wide_trace_packets<N, M, K>(bvh, scene, kernels, config, rays, hits);
         }
         return;
     }
