@@ -1,7 +1,8 @@
 #pragma once
 // The loop every packet traversal shares: cut the rays into packets of K
 // (the last one ragged, its missing lanes inactive), trace each, and write
-// the hits back in the exchange layout (for any hit, prim 0 = occluded).
+// the answers back: hits in the exchange layout (for any hit, prim 0 =
+// occluded), or any-hit answers as bytes (1 = occluded).
 #include <immintrin.h>
 
 #include <algorithm>

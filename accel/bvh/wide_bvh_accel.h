@@ -42,7 +42,6 @@ private:
     template <bool AnyHit, class Out>
     void trace(std::span<const Rayf> rays, Out&& out) const;
 
-
     static constexpr bool kPackets = M == 8 && Test == NodeTest::Ordered;
     const Scene* scene_;  ///< --precision double tests leaves' primitives by id
     KernelChoice kernels_;
