@@ -14,15 +14,13 @@ namespace raypack {
 template <int N, int M, NodeTest Test>
 CollapseConfig WideBvhAccel<N, M, Test>::collapse_config(const AccelConfig& config) {
     CollapseConfig c;
-    // A wide node costs the walks that run by default about three block
-    // tests: packets and streams test a leaf K rays x 1 primitive, but a
-    // node's N box tests, its children's order and (streams) one compacted
-    // list per child weigh more. Measured (session 41, one thread, against
-    // one block per node and leaves of 2 M): streams of diffuse rays 7-11%
-    // faster on gears and the bunny, the path-traced bunny 4%, Whitted
-    // renders of the SPD scenes within -2..+1%, camera and shadow rays and
-    // single rays within noise. config.traversal_cost / intersection_cost
-    // keep their meaning as the ratio of the two.
+    // The default walks (packets, streams) test a leaf K rays x 1
+    // primitive, and pay about three block tests at a wide node: N box
+    // tests, the children's order and, in a stream, a list per child.
+    // Leaves of up to 3 M: diffuse streams 7-11% faster on gears and the
+    // bunny, the rest within noise (docs/structures.md, session 41).
+    // config.traversal_cost / intersection_cost keep their meaning as the
+    // ratio of the two.
     c.node_cost = 3.0f * config.traversal_cost;
     c.block_cost = config.intersection_cost;
     c.max_leaf_prims = 3 * M;
